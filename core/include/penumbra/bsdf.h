@@ -1,0 +1,59 @@
+// Materials as BSDF plugins. A Bsdf is created once per material directive with constant
+// parameters; it evaluates and samples scattering in the local shading frame of a hit (normal +z).
+// Directions point away from the surface. f() excludes the cosine factor.
+#pragma once
+
+#include <penumbra/color.h>
+#include <penumbra/math.h>
+#include <penumbra/object.h>
+
+#include <cstdint>
+#include <optional>
+
+namespace penumbra {
+
+/// Whether radiance (camera paths) or importance (light paths) is being transported; non-symmetric
+/// BSDFs (refraction) differ between the two.
+enum class TransportMode { Radiance, Importance };
+
+enum BsdfFlags : uint32_t {
+  BsdfReflection = 1u << 0,
+  BsdfTransmission = 1u << 1,
+  BsdfDiffuse = 1u << 2,
+  BsdfGlossy = 1u << 3,
+  BsdfSpecular = 1u << 4,
+};
+
+/// Where the BSDF is evaluated, for future textured parameters.
+struct ShadingContext {
+  Vec2 uv{0.f};
+  TransportMode mode = TransportMode::Radiance;
+};
+
+struct BsdfSample {
+  Rgb f{0.f};          // BSDF value for (wo, wi); for specular lobes the delta's weight
+  Vec3 wi{0.f};        // sampled incident direction, local frame
+  float pdf = 0.f;     // solid-angle density (specular: the discrete probability of the lobe)
+  uint32_t flags = 0;  // lobe that was sampled (BsdfFlags)
+  bool is_specular() const { return (flags & BsdfSpecular) != 0; }
+};
+
+class Bsdf : public Object {
+ public:
+  ~Bsdf() override;
+  /// Union of the lobes this BSDF can have (BsdfFlags).
+  virtual uint32_t flags() const = 0;
+  virtual Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const = 0;
+  /// Samples wi given wo; uc picks a lobe, u the direction. Empty when no direction was produced.
+  virtual std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u,
+                                             const ShadingContext& ctx) const = 0;
+  /// Density with which sample_f() returns wi (0 for specular lobes).
+  virtual float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const = 0;
+
+  bool is_specular_only() const {
+    uint32_t f = flags();
+    return (f & BsdfSpecular) && !(f & (BsdfDiffuse | BsdfGlossy));
+  }
+};
+
+}  // namespace penumbra

@@ -1,0 +1,60 @@
+// Lights as plugins. Area lights are attached to one primitive of a shape (a triangle or a sphere)
+// and receive it at creation; other lights are placed by the transform of their directive.
+#pragma once
+
+#include <penumbra/color.h>
+#include <penumbra/interaction.h>
+#include <penumbra/math.h>
+#include <penumbra/object.h>
+#include <penumbra/shape.h>
+
+#include <cstdint>
+#include <optional>
+
+namespace penumbra {
+
+enum class LightType { DeltaPosition, DeltaDirection, Area, Infinite };
+
+inline bool is_delta_light(LightType t) {
+  return t == LightType::DeltaPosition || t == LightType::DeltaDirection;
+}
+
+/// The receiving point of a light sample: position, geometric normal (zero if none).
+struct LightSampleContext {
+  Vec3 p;
+  Vec3 n{0.f};
+};
+
+struct LightLiSample {
+  Rgb L{0.f};      // incident radiance (before visibility)
+  Vec3 wi;         // unit direction towards the light
+  float pdf = 0.f; // solid angle density (delta lights: 1)
+  Vec3 p_light;    // sampled point (for the shadow ray)
+  Vec3 n_light{0.f};  // its normal (zero for points not on a surface)
+};
+
+class Light : public Object {
+ public:
+  ~Light() override;
+  virtual LightType type() const = 0;
+  /// Emitted power (flux), for light selection.
+  virtual Rgb power() const = 0;
+  /// Samples incident illumination at ctx. Empty when no contribution is possible.
+  virtual std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const = 0;
+  /// Solid-angle density of sample_li() choosing the point `hit` seen from ctx in direction wi.
+  virtual float pdf_li(const LightSampleContext& ctx, const Vec3& wi,
+                       const SurfaceInteraction& hit) const = 0;
+  /// Area lights: radiance leaving surface point (p, n, uv) in direction w.
+  virtual Rgb L(const Vec3& p, const Vec3& n, const Vec2& uv, const Vec3& w) const;
+  /// Infinite lights: radiance arriving along a ray that escapes the scene.
+  virtual Rgb Le(const Ray& ray) const;
+
+  /// Index in the scene's light list (set by the runtime; used for light-selection pmfs).
+  uint32_t index() const { return index_; }
+  void set_index(uint32_t i) { index_ = i; }
+
+ private:
+  uint32_t index_ = 0;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,69 @@
+// The plugin contract. A plugin is a shared library `penumbra-<kind>-<name>.so` exporting one C
+// function, penumbra_plugin_info(), that describes it: the SDK version it was built against, its
+// kind, name and aliases, a one-line description, its parameter table and a factory. Write it with
+// the PENUMBRA_PLUGIN macro:
+//
+//   static const penumbra::ParamSpec kParams[] = {
+//       {"integer", "maxdepth", "5", "longest path, in bounces"}};
+//   static penumbra::Object* create(const penumbra::CreateContext& ctx) { return new MyPath(ctx); }
+//   PENUMBRA_PLUGIN(Integrator, "mypath", "My path tracer", kParams, create)
+#pragma once
+
+#include <penumbra/error.h>
+#include <penumbra/math.h>
+#include <penumbra/object.h>
+#include <penumbra/params.h>
+#include <penumbra/shape.h>
+#include <penumbra/version.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace penumbra {
+
+enum class PluginKind : uint32_t { Integrator = 0, Sampler = 1, Bsdf = 2, Light = 3 };
+
+/// "integrator", "sampler", "bsdf" or "light".
+const char* plugin_kind_name(PluginKind kind);
+
+/// Everything a factory gets. Parameters have been validated against the plugin's table.
+struct CreateContext {
+  const ParamSet& params;
+  FileLoc loc;                    // where the scene names the plugin
+  std::string scene_dir;          // folder of the scene file, for relative file names
+  Mat4 to_world{1.f};             // transform in effect at the directive (lights)
+  const Shape* shape = nullptr;   // area lights: the primitive they are attached to
+  bool reverse_orientation = false;
+};
+
+using PluginFactory = Object* (*)(const CreateContext& ctx);
+
+/// Layout is fixed across SDK versions up to `sdk_version` so that the loader can read it from a
+/// plugin built for another version and refuse it.
+struct PluginInfo {
+  uint32_t sdk_version;
+  PluginKind kind;
+  const char* name;
+  const char* const* aliases;  // null-terminated list, may be null
+  const char* doc;
+  const ParamSpec* params;
+  size_t param_count;
+  PluginFactory create;
+};
+
+}  // namespace penumbra
+
+#define PENUMBRA_PLUGIN_ENTRY penumbra_plugin_info
+
+#define PENUMBRA_PLUGIN_WITH_ALIASES(KIND, NAME, DOC, PARAMS, FACTORY, ALIASES)                 \
+  extern "C" __attribute__((visibility("default"))) const ::penumbra::PluginInfo*               \
+  penumbra_plugin_info() {                                                                     \
+    static const ::penumbra::PluginInfo info{PENUMBRA_SDK_VERSION, ::penumbra::PluginKind::KIND, \
+                                             NAME, ALIASES, DOC, PARAMS,                      \
+                                             sizeof(PARAMS) / sizeof(PARAMS[0]), FACTORY};     \
+    return &info;                                                                              \
+  }
+
+#define PENUMBRA_PLUGIN(KIND, NAME, DOC, PARAMS, FACTORY) \
+  PENUMBRA_PLUGIN_WITH_ALIASES(KIND, NAME, DOC, PARAMS, FACTORY, nullptr)

@@ -1,0 +1,45 @@
+// The scene as integrators see it: ray queries through Embree, lights with a selection
+// distribution proportional to power, the camera and the bounds.
+#pragma once
+
+#include <penumbra/camera.h>
+#include <penumbra/interaction.h>
+#include <penumbra/light.h>
+
+#include <optional>
+#include <span>
+
+namespace penumbra {
+
+struct Bounds3 {
+  Vec3 min{Infinity};
+  Vec3 max{-Infinity};
+  void extend(const Vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
+};
+
+struct SampledLight {
+  const Light* light = nullptr;
+  float pmf = 0.f;
+};
+
+class Scene {
+ public:
+  virtual ~Scene();
+  /// Closest hit along the ray in (0, ray.tmax).
+  virtual std::optional<SurfaceInteraction> intersect(const Ray& ray) const = 0;
+  /// Whether anything is hit in (0, ray.tmax).
+  virtual bool occluded(const Ray& ray) const = 0;
+
+  virtual std::span<const Light* const> lights() const = 0;
+  /// Lights that rays escaping the scene see (environment, distant sources excluded).
+  virtual std::span<const Light* const> infinite_lights() const = 0;
+  /// Picks a light with probability proportional to its power. Empty when there are no lights.
+  virtual std::optional<SampledLight> sample_light(float u) const = 0;
+  /// Probability that sample_light() picks `light`.
+  virtual float light_pmf(const Light* light) const = 0;
+
+  virtual const Camera& camera() const = 0;
+  virtual Bounds3 bounds() const = 0;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,50 @@
+// Shapes as area-light plugins see them: one sampleable primitive (a triangle or a sphere) with an
+// oriented surface normal (pbrt's rules: mesh normals decide a triangle's side when given, otherwise
+// the winding, flipped by ReverseOrientation or a handedness-changing transform).
+#pragma once
+
+#include <penumbra/math.h>
+
+#include <optional>
+
+namespace penumbra {
+
+/// A point on a shape chosen for a reference point; `pdf` is per unit area or per unit solid angle
+/// as the function says.
+struct ShapeSample {
+  Vec3 p;
+  Vec3 n;  // oriented geometric normal at p
+  Vec2 uv;
+  float pdf = 0.f;
+};
+
+/// Where a shape is sampled from: a point, and its surface normal when it lies on a surface.
+struct ShapeSampleContext {
+  Vec3 p;
+  Vec3 n{0.f};  // zero when the point is not on a surface
+};
+
+class Shape {
+ public:
+  virtual ~Shape();
+  virtual float area() const = 0;
+  /// Uniform by area; pdf per unit area.
+  virtual ShapeSample sample_area(Vec2 u) const = 0;
+  /// A point seen from ctx; pdf per unit solid angle at ctx.p. Empty when nothing can be sampled.
+  virtual std::optional<ShapeSample> sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const = 0;
+  /// Density of sample_solid_angle() producing the point p_hit (normal n_hit) in direction wi.
+  virtual float pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
+                                const Vec3& n_hit) const = 0;
+};
+
+/// Converts a per-area density at p_light (normal n_light) to per solid angle at p.
+inline float area_to_solid_angle_pdf(float pdf_area, const Vec3& p, const Vec3& p_light,
+                                     const Vec3& n_light) {
+  Vec3 d = p_light - p;
+  float dist2 = glm::dot(d, d);
+  float cos_l = std::abs(glm::dot(n_light, d)) / std::sqrt(dist2);
+  if (cos_l == 0.f || dist2 == 0.f) return 0.f;
+  return pdf_area * dist2 / cos_l;
+}
+
+}  // namespace penumbra
