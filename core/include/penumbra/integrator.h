@@ -4,6 +4,7 @@
 // non-finite samples (counted in the stats) before they reach the film.
 #pragma once
 
+#include <penumbra/bsdf.h>
 #include <penumbra/film.h>
 #include <penumbra/object.h>
 #include <penumbra/sampler.h>

@@ -21,6 +21,8 @@ namespace penumbra {
 /// "point3", "vector3", "normal"), name, default value as scene-file text ("5", "0.5 0.5 0.5",
 /// "true", "box"; empty when there is none) and a one-line description.
 /// A type ending in "[]" ("point3[]") takes any number of values (meshes); others take one value.
+/// Type "unsupported" declares a pbrt parameter Penumbra knows but does not implement: giving it is
+/// an error that says so (the doc text explains why or what to use instead).
 struct ParamSpec {
   const char* type;
   const char* name;

@@ -95,7 +95,8 @@ static Param parse_default(const ParamSpec& s) {
 void ParamSet::validate(std::span<const ParamSpec> spec, const std::string& what) {
   defaults_.clear();
   for (const auto& s : spec)
-    if (s.default_value && *s.default_value) defaults_.push_back(parse_default(s));
+    if (s.default_value && *s.default_value && std::string(s.type) != "unsupported")
+      defaults_.push_back(parse_default(s));
   for (const auto& p : params_) {
     const ParamSpec* match = nullptr;
     for (const auto& s : spec)
@@ -112,6 +113,9 @@ void ParamSet::validate(std::span<const ParamSpec> spec, const std::string& what
         hint = fmt::format("; did you mean '{}'?", best);
       throw Error(p.loc, fmt::format("unknown parameter '{}' for {}{}", p.name, what, hint));
     }
+    if (std::string(match->type) == "unsupported")
+      throw Error(p.loc, fmt::format("parameter '{}' of {} is not supported by Penumbra{}{}", p.name,
+                                     what, *match->doc ? ": " : "", match->doc));
     auto [base, array] = spec_base(match->type);
     if (!type_accepts(base, p.type))
       throw Error(p.loc, fmt::format("parameter '{}' of {} must have type '{}', not '{}'", p.name,

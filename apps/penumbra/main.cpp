@@ -1,0 +1,81 @@
+// penumbra: render pbrt-v4 scene files with plugin integrators, samplers, materials and lights.
+//   penumbra                       renders the bundled Cornell box
+//   penumbra render SCENE [opts]   renders a scene, command-line options override the file
+//   penumbra plugins               lists the plugins found and their parameters
+#include "commands.h"
+
+#include <penumbra/error.h>
+#include <penumbra/version.h>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <regex>
+
+namespace {
+
+std::pair<int, int> parse_resolution(const std::string& text) {
+  std::smatch m;
+  static const std::regex re(R"((\d{1,5})[xX](\d{1,5}))");
+  if (!std::regex_match(text, m, re) || std::stoi(m[1]) == 0 || std::stoi(m[2]) == 0)
+    throw penumbra::Error(fmt::format("--res: expected WIDTHxHEIGHT (e.g. 320x240), got '{}'", text));
+  return {std::stoi(m[1]), std::stoi(m[2])};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Penumbra " PENUMBRA_VERSION_STRING ": a plugin-based physically based renderer"};
+  app.set_version_flag("--version", PENUMBRA_VERSION_STRING);
+  app.require_subcommand(0, 1);
+
+  penumbra::RenderSettings settings;
+  std::string res;
+  int spp = 0;
+  uint32_t seed = 0;
+  auto* render = app.add_subcommand("render", "Render a scene file");
+  render->add_option("scene", settings.scene_file, "pbrt-v4 scene file")->required()->check(CLI::ExistingFile);
+  render->add_option("-o,--output", settings.output, "output image (.exr, .hdr, .tif, .png); default: the Film's filename");
+  auto* spp_opt = render->add_option("--spp", spp, "samples per pixel (overrides the Sampler's pixelsamples)")->check(CLI::PositiveNumber);
+  render->add_option("--time", settings.time_budget, "time budget in seconds (renders whole passes until it is spent)")->check(CLI::PositiveNumber);
+  render->add_option("--threads", settings.threads, "worker threads (default: all cores)")->check(CLI::Range(1, 1024));
+  auto* seed_opt = render->add_option("--seed", seed, "sampler seed");
+  render->add_option("--integrator", settings.integrator, "integrator plugin to use instead of the scene's");
+  render->add_option("--sampler", settings.sampler, "sampler plugin to use instead of the scene's");
+  render->add_option("--res", res, "image resolution WIDTHxHEIGHT");
+  render->add_option("--stats", settings.stats_file, "write render statistics as JSON");
+  render->add_flag("-q,--quiet", settings.quiet, "no progress output");
+
+  std::vector<std::string> plugin_dirs;
+  auto* plugins = app.add_subcommand("plugins", "List plugins with their parameters");
+  plugins->add_option("--dir", plugin_dirs, "search these folders instead of the default path");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "error: %s\nRun with --help for usage.\n", e.what());
+    return 1;
+  }
+
+  try {
+    if (*plugins) return penumbra::cli::run_plugins(plugin_dirs);
+    if (!*render) settings.scene_file = penumbra::cli::default_scene();
+    if (*spp_opt) settings.spp = spp;
+    if (*seed_opt) settings.seed = seed;
+    if (!res.empty()) settings.resolution = parse_resolution(res);
+    return penumbra::cli::run_render(settings);
+  } catch (const penumbra::Error& e) {
+    std::fprintf(stderr, "%s\n", e.formatted().c_str());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}

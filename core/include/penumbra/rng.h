@@ -1,0 +1,74 @@
+// PCG32 (O'Neill 2014) with jump-ahead, and integer hashing to derive independent streams from
+// (pixel, sample index, seed) tuples.
+#pragma once
+
+#include <penumbra/math.h>
+
+#include <cstdint>
+
+namespace penumbra {
+
+/// 64-bit finaliser of MurmurHash3: decorrelates sequential inputs.
+inline uint64_t mix_bits(uint64_t v) {
+  v ^= v >> 31;
+  v *= 0x7fb5d329728ea185ull;
+  v ^= v >> 27;
+  v *= 0x81dadef4bc2dd44dull;
+  v ^= v >> 33;
+  return v;
+}
+
+/// Hash of up to four integers.
+inline uint64_t hash_ints(uint64_t a, uint64_t b = 0, uint64_t c = 0, uint64_t d = 0) {
+  uint64_t h = mix_bits(a + 0x9e3779b97f4a7c15ull);
+  h = mix_bits(h ^ (b + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2)));
+  h = mix_bits(h ^ (c + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2)));
+  return mix_bits(h ^ (d + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2)));
+}
+
+class Pcg32 {
+ public:
+  Pcg32() { set_sequence(0, 0x853c49e6748fea9bull); }
+  Pcg32(uint64_t sequence, uint64_t seed) { set_sequence(sequence, seed); }
+
+  /// Selects stream `sequence` (any value) starting from `seed`.
+  void set_sequence(uint64_t sequence, uint64_t seed) {
+    state_ = 0u;
+    inc_ = (sequence << 1u) | 1u;
+    next_u32();
+    state_ += seed;
+    next_u32();
+  }
+
+  uint32_t next_u32() {
+    uint64_t old = state_;
+    state_ = old * kMult + inc_;
+    uint32_t xorshifted = static_cast<uint32_t>(((old >> 18u) ^ old) >> 27u);
+    uint32_t rot = static_cast<uint32_t>(old >> 59u);
+    return (xorshifted >> rot) | (xorshifted << ((~rot + 1u) & 31));
+  }
+
+  /// Uniform in [0, 1).
+  float next_float() { return std::min(OneMinusEpsilon, next_u32() * 0x1p-32f); }
+
+  /// Skips `delta` outputs in O(log delta) (Brown's algorithm).
+  void advance(uint64_t delta) {
+    uint64_t cur_mult = kMult, cur_plus = inc_, acc_mult = 1u, acc_plus = 0u;
+    while (delta > 0) {
+      if (delta & 1) {
+        acc_mult *= cur_mult;
+        acc_plus = acc_plus * cur_mult + cur_plus;
+      }
+      cur_plus = (cur_mult + 1) * cur_plus;
+      cur_mult *= cur_mult;
+      delta /= 2;
+    }
+    state_ = acc_mult * state_ + acc_plus;
+  }
+
+ private:
+  static constexpr uint64_t kMult = 0x5851f42d4c957f2dull;
+  uint64_t state_, inc_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,138 @@
+#include "image/film_rgb.h"
+
+#include "image/image_io.h"
+
+#include <fmt/core.h>
+
+namespace penumbra {
+
+static const ParamSpec kBoxParams[] = {
+    {"float", "xradius", "0.5", "half width of the filter in pixels"},
+    {"float", "yradius", "0.5", "half height of the filter in pixels"},
+};
+static const ParamSpec kTriangleParams[] = {
+    {"float", "xradius", "2", "half width of the filter in pixels"},
+    {"float", "yradius", "2", "half height of the filter in pixels"},
+};
+static const ParamSpec kGaussianParams[] = {
+    {"float", "xradius", "1.5", "half width of the filter in pixels"},
+    {"float", "yradius", "1.5", "half height of the filter in pixels"},
+    {"float", "sigma", "0.5", "standard deviation in pixels"},
+};
+static const ParamSpec kFilmParams[] = {
+    {"integer", "xresolution", "1280", "image width in pixels"},
+    {"integer", "yresolution", "720", "image height in pixels"},
+    {"string", "filename", "penumbra.exr", "output image (.exr, .hdr, .tif, .png)"},
+    {"unsupported", "cropwindow", "", ""},
+    {"unsupported", "pixelbounds", "", ""},
+    {"unsupported", "diagonal", "", "Penumbra's film has no physical size"},
+    {"unsupported", "iso", "", "Penumbra's film has no sensor model"},
+    {"unsupported", "exposuretime", "", "Penumbra's film has no sensor model"},
+    {"unsupported", "whitebalance", "", "Penumbra's film has no sensor model"},
+    {"unsupported", "sensor", "", "Penumbra's film has no sensor model"},
+    {"unsupported", "maxcomponentvalue", "", "Penumbra never clamps samples"},
+    {"unsupported", "savefp16", "", "EXR files are written in 32-bit float"},
+};
+
+std::span<const ParamSpec> film_rgb_params() { return kFilmParams; }
+
+std::span<const ParamSpec> pixel_filter_params(const std::string& type) {
+  if (type == "box") return kBoxParams;
+  if (type == "triangle") return kTriangleParams;
+  if (type == "gaussian") return kGaussianParams;
+  return {};
+}
+
+PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const FileLoc& loc)
+    : type_(type) {
+  if (pixel_filter_params(type).empty())
+    throw Error(loc, fmt::format("unsupported pixel filter '{}'; available: box, gaussian, triangle", type));
+  radius_ = Vec2(params.get_float("xradius"), params.get_float("yradius"));
+  if (!(radius_.x > 0.f && radius_.y > 0.f && radius_.x < 64.f && radius_.y < 64.f))
+    throw Error(loc, "filter radii must be in (0, 64) pixels");
+  if (type == "gaussian") {
+    sigma_ = params.get_float("sigma");
+    if (!(sigma_ > 0.f)) throw Error(params.loc_of("sigma"), "sigma must be > 0");
+    for (int axis = 0; axis < 2; ++axis) {
+      const int n = 256;
+      std::vector<float> f(n);
+      for (int i = 0; i < n; ++i) {
+        float x = radius_[axis] * (2.f * (i + 0.5f) / n - 1.f);
+        f[i] = eval_gaussian(x, radius_[axis]);
+      }
+      table_[axis] = Distribution1D(f);
+    }
+  }
+}
+
+float PixelFilter::eval_gaussian(float x, float r) const {
+  auto g = [&](float t) { return std::exp(-t * t / (2.f * sigma_ * sigma_)); };
+  return std::max(0.f, g(x) - g(r));
+}
+
+// Samples one axis of the separable filter; `weight` gets f(x)/pdf(x), up to a constant factor that
+// cancels in the weighted pixel mean.
+float PixelFilter::sample_axis(float u, int axis, float* weight) const {
+  float r = radius_[axis];
+  if (type_ == "box") {
+    *weight = 1.f;
+    return (2.f * u - 1.f) * r;
+  }
+  if (type_ == "triangle") {
+    *weight = 1.f;
+    return u < 0.5f ? -r + r * std::sqrt(2.f * u) : r - r * std::sqrt(2.f - 2.f * u);
+  }
+  float pdf = 0.f;
+  float t = table_[axis].sample_continuous(u, &pdf);
+  float x = (2.f * t - 1.f) * r;
+  float pdf_x = pdf / (2.f * r);
+  *weight = pdf_x > 0.f ? eval_gaussian(x, r) / pdf_x : 0.f;
+  return x;
+}
+
+FilterSample PixelFilter::sample(Vec2 u) const {
+  float wx, wy;
+  float x = sample_axis(u.x, 0, &wx);
+  float y = sample_axis(u.y, 1, &wy);
+  return FilterSample{Vec2(x, y), wx * wy};
+}
+
+FilmRgb::FilmRgb(Point2i resolution, PixelFilter filter)
+    : resolution_(resolution), filter_(std::move(filter)),
+      pixels_(static_cast<size_t>(resolution.x) * resolution.y) {}
+
+void FilmRgb::add_sample(Point2i pixel, const Rgb& L, float weight) {
+  Pixel& px = pixels_[static_cast<size_t>(pixel.y) * resolution_.x + pixel.x];
+  for (int c = 0; c < 3; ++c) px.rgb[c] += static_cast<double>(weight) * L[c];
+  px.weight += weight;
+}
+
+void FilmRgb::add_splat(const Vec2& p_raster, const Rgb& v) {
+  int x = static_cast<int>(std::floor(p_raster.x)), y = static_cast<int>(std::floor(p_raster.y));
+  if (x < 0 || y < 0 || x >= resolution_.x || y >= resolution_.y) return;
+  std::call_once(splat_once_, [&] {
+    size_t n = 3 * pixels_.size();
+    splats_ = std::make_unique<std::atomic<double>[]>(n);
+    for (size_t i = 0; i < n; ++i) splats_[i].store(0.0, std::memory_order_relaxed);
+  });
+  size_t i = 3 * (static_cast<size_t>(y) * resolution_.x + x);
+  for (int c = 0; c < 3; ++c) splats_[i + c].fetch_add(v[c], std::memory_order_relaxed);
+}
+
+ImageRgb FilmRgb::image(double splat_spp) const {
+  ImageRgb img;
+  img.width = resolution_.x;
+  img.height = resolution_.y;
+  img.pixels.resize(3 * pixels_.size());
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& px = pixels_[i];
+    for (int c = 0; c < 3; ++c) {
+      double v = px.weight != 0.0 ? px.rgb[c] / px.weight : 0.0;
+      if (splats_ && splat_spp > 0.0) v += splats_[3 * i + c].load(std::memory_order_relaxed) / splat_spp;
+      img.pixels[3 * i + c] = static_cast<float>(v);
+    }
+  }
+  return img;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,64 @@
+// The RGB film: double-precision accumulation of filtered pixel samples, a lazily allocated
+// thread-safe splat buffer, and filter importance sampling for box, triangle and Gaussian filters.
+#pragma once
+
+#include <penumbra/film.h>
+#include <penumbra/params.h>
+#include <penumbra/sampling.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace penumbra {
+
+/// A separable pixel filter that the film samples exactly (box, triangle) or by tabulation (Gaussian).
+class PixelFilter {
+ public:
+  /// type: "box", "triangle" or "gaussian"; params as pbrt-v4 names them.
+  PixelFilter(const std::string& type, const ParamSet& params, const FileLoc& loc);
+  FilterSample sample(Vec2 u) const;
+  Vec2 radius() const { return radius_; }
+  const std::string& type() const { return type_; }
+
+ private:
+  float sample_axis(float u, int axis, float* weight) const;
+  float eval_gaussian(float x, float r) const;
+  std::string type_;
+  Vec2 radius_;
+  float sigma_ = 0.5f;
+  Distribution1D table_[2];  // Gaussian only: tabulated filter per axis
+};
+
+std::span<const ParamSpec> pixel_filter_params(const std::string& type);
+std::span<const ParamSpec> film_rgb_params();
+
+struct ImageRgb;
+
+class FilmRgb final : public Film {
+ public:
+  FilmRgb(Point2i resolution, PixelFilter filter);
+  Point2i resolution() const override { return resolution_; }
+  FilterSample sample_filter(Vec2 u) const override { return filter_.sample(u); }
+  void add_sample(Point2i pixel, const Rgb& L, float weight) override;
+  void add_splat(const Vec2& p_raster, const Rgb& v) override;
+  /// The image: weighted pixel means plus splats divided by `splat_spp`.
+  ImageRgb image(double splat_spp) const;
+  bool has_splats() const { return splats_ != nullptr; }
+
+ private:
+  struct Pixel {
+    double rgb[3] = {0, 0, 0};
+    double weight = 0;
+  };
+  Point2i resolution_;
+  PixelFilter filter_;
+  std::vector<Pixel> pixels_;
+  std::unique_ptr<std::atomic<double>[]> splats_;  // allocated on the first splat
+  std::once_flag splat_once_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,22 @@
+// Counts rays per thread without contention; the total is read once a render has finished.
+#pragma once
+
+#include <cstdint>
+
+namespace penumbra {
+
+void count_rays_slow_path();
+struct ThreadRayCount {
+  uint64_t rays = 0;
+};
+extern thread_local ThreadRayCount* t_ray_count;
+
+inline void count_ray() {
+  if (!t_ray_count) count_rays_slow_path();
+  ++t_ray_count->rays;
+}
+
+/// Sum over all threads that ever traced a ray (read while no render is running).
+uint64_t total_rays();
+
+}  // namespace penumbra

@@ -1,0 +1,209 @@
+#include "render/render_session.h"
+
+#include "parser/scene_description.h"
+#include "registry/registry.h"
+#include "render/progress.h"
+#include "render/ray_counter.h"
+#include "scene/scene_builder.h"
+
+#include <penumbra/version.h>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include <sys/resource.h>
+
+#include <atomic>
+#include <chrono>
+#include <climits>
+#include <fstream>
+#include <mutex>
+
+namespace penumbra {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+uint64_t peak_memory_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<uint64_t>(usage.ru_maxrss) * 1024u;
+}
+
+class Session final : public RenderContext {
+ public:
+  Session(BuiltScene& built, RenderOptions options, bool quiet)
+      : built_(built), options_(options), progress_("samples", quiet) {}
+
+  const Scene& scene() const override { return *built_.scene; }
+  Film& film() override { return *built_.film; }
+  const Sampler& sampler() const override { return *built_.sampler; }
+  const RenderOptions& options() const override { return options_; }
+  double elapsed() const override { return seconds_since(start_); }
+  void progress(uint64_t done, uint64_t total) override {
+    progress_.update(done, total, elapsed(), options_.time_budget);
+  }
+  void report_nonfinite(Point2i pixel) override {
+    if (nonfinite_.fetch_add(1) == 0) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      first_nonfinite_ = {pixel.x, pixel.y};
+    }
+  }
+  void set_completed_spp(int spp) override { completed_spp_ = spp; }
+
+  void start() { start_ = Clock::now(); }
+  void finish() { progress_.finish(elapsed()); }
+  int completed_spp() const { return completed_spp_; }
+  uint64_t nonfinite() const { return nonfinite_.load(); }
+  std::optional<std::pair<int, int>> first_nonfinite() const { return first_nonfinite_; }
+
+ private:
+  BuiltScene& built_;
+  RenderOptions options_;
+  ProgressReporter progress_;
+  Clock::time_point start_ = Clock::now();
+  std::atomic<uint64_t> nonfinite_{0};
+  std::optional<std::pair<int, int>> first_nonfinite_;
+  std::mutex mutex_;
+  int completed_spp_ = 0;
+};
+
+// Replaces a plugin chosen by the scene with one named on the command line. Parameters the new
+// plugin also declares (maxdepth, pixelsamples, seed) carry over; the others are dropped, with a note.
+void override_plugin(SceneEntity& entity, PluginKind kind, const std::string& name, Registry& registry) {
+  const PluginInfo& info = *registry.load(kind, name).info;
+  ParamSet kept;
+  for (const Param& p : entity.params.params()) {
+    bool known = false;
+    for (size_t i = 0; i < info.param_count; ++i)
+      known = known || (p.name == info.params[i].name && std::string(info.params[i].type) != "unsupported");
+    if (known)
+      kept.add(p);
+    else if (entity.type != name)
+      warning(p.loc, fmt::format("parameter '{}' dropped: {} '{}' does not take it", p.name,
+                                 plugin_kind_name(kind), name));
+  }
+  entity.type = name;
+  entity.params = std::move(kept);
+}
+
+}  // namespace
+
+RenderResult render(const RenderSettings& settings) {
+  auto t0 = Clock::now();
+  size_t rays_before = total_rays();
+  SceneDescription desc = parse_scene_file(settings.scene_file);
+  Registry registry(settings.plugin_dirs.empty() ? Registry::default_search_dirs() : settings.plugin_dirs);
+
+  // Command-line overrides act on the description, before the scene's own choices are looked up.
+  if (!settings.integrator.empty())
+    override_plugin(desc.integrator, PluginKind::Integrator, settings.integrator, registry);
+  if (!settings.sampler.empty())
+    override_plugin(desc.sampler, PluginKind::Sampler, settings.sampler, registry);
+  if (settings.spp) {
+    if (*settings.spp <= 0) throw Error("--spp must be positive");
+    desc.sampler.params.set_int("pixelsamples", *settings.spp);
+  }
+  if (settings.seed) desc.sampler.params.set_int("seed", static_cast<int>(*settings.seed));
+  if (settings.resolution) {
+    desc.film.params.set_int("xresolution", settings.resolution->first);
+    desc.film.params.set_int("yresolution", settings.resolution->second);
+  }
+
+  int threads = settings.threads > 0 ? settings.threads : tbb::info::default_concurrency();
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+
+  BuiltScene built = build_scene(desc, registry);
+  RenderOptions options;
+  options.time_budget = settings.time_budget;
+  options.threads = threads;
+  options.spp = built.sampler->samples_per_pixel();
+  if (settings.time_budget > 0.0 && !settings.spp) options.spp = INT_MAX;
+  if (options.spp <= 0) throw Error(desc.sampler.params.loc_of("pixelsamples"), "pixelsamples must be positive");
+  double load_seconds = seconds_since(t0);
+
+  Session session(built, options, settings.quiet);
+  session.start();
+  built.integrator->render(session);
+  double seconds = session.elapsed();
+  session.finish();
+
+  RenderResult result;
+  result.image = built.film->image(session.completed_spp());
+  if (built.film->has_splats()) built.structures_built.push_back("film_splat_buffer");
+  RenderStats& s = result.stats;
+  s.seconds = seconds;
+  s.load_seconds = load_seconds;
+  s.spp = session.completed_spp();
+  s.pixels = static_cast<uint64_t>(result.image.width) * result.image.height;
+  s.rays = total_rays() - rays_before;
+  s.nonfinite_samples = session.nonfinite();
+  s.first_nonfinite_pixel = session.first_nonfinite();
+  s.peak_memory_bytes = peak_memory_bytes();
+  s.plugins_loaded = registry.loaded();
+  s.structures_built = built.structures_built;
+  s.integrator = built.integrator_name;
+  s.sampler = built.sampler_name;
+  s.scene_file = settings.scene_file;
+  s.output = settings.output.empty() ? built.output_filename : settings.output;
+  s.threads = threads;
+  s.seed = static_cast<uint32_t>(desc.sampler.params.get_int("seed", 0));
+  s.triangles = built.scene->triangle_count();
+  if (s.nonfinite_samples > 0)
+    warning({}, fmt::format("{} non-finite samples were discarded (first at pixel {}, {})",
+                            s.nonfinite_samples, s.first_nonfinite_pixel->first,
+                            s.first_nonfinite_pixel->second));
+  return result;
+}
+
+std::string stats_json(const RenderStats& s) {
+  nlohmann::json j;
+  j["seconds"] = s.seconds;
+  j["load_seconds"] = s.load_seconds;
+  j["spp"] = s.spp;
+  j["pixels"] = s.pixels;
+  j["rays"] = s.rays;
+  j["mrays_per_second"] = s.mrays_per_second();
+  j["samples_per_second"] = s.seconds > 0 ? s.pixels * static_cast<double>(s.spp) / s.seconds : 0.0;
+  j["plugins_loaded"] = s.plugins_loaded;
+  j["structures_built"] = s.structures_built;
+  j["nonfinite_samples"] = s.nonfinite_samples;
+  j["first_nonfinite_pixel"] = s.first_nonfinite_pixel
+                                   ? nlohmann::json::array({s.first_nonfinite_pixel->first,
+                                                            s.first_nonfinite_pixel->second})
+                                   : nlohmann::json(nullptr);
+  j["peak_memory_bytes"] = s.peak_memory_bytes;
+  j["integrator"] = s.integrator;
+  j["sampler"] = s.sampler;
+  j["scene"] = s.scene_file;
+  j["output"] = s.output;
+  j["threads"] = s.threads;
+  j["seed"] = s.seed;
+  j["triangles"] = s.triangles;
+  return j.dump(2) + "\n";
+}
+
+void write_outputs(const RenderSettings& settings, const RenderResult& result) {
+  const RenderStats& s = result.stats;
+  write_image(s.output, result.image,
+              {{"penumbra:version", PENUMBRA_VERSION_STRING},
+               {"penumbra:integrator", s.integrator},
+               {"penumbra:sampler", s.sampler},
+               {"penumbra:spp", std::to_string(s.spp)},
+               {"penumbra:seed", std::to_string(s.seed)},
+               {"penumbra:scene", s.scene_file}});
+  if (!settings.stats_file.empty()) {
+    std::ofstream out(settings.stats_file);
+    if (!out) throw Error(fmt::format("cannot write stats file {}", settings.stats_file));
+    out << stats_json(s);
+  }
+}
+
+}  // namespace penumbra

@@ -1,0 +1,59 @@
+// One render from a scene file to images and a stats file: the entry point the command-line
+// program, the tests and the benchmarks share.
+#pragma once
+
+#include "image/image_io.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace penumbra {
+
+/// Command-line choices; each one, when set, overrides what the scene file says.
+struct RenderSettings {
+  std::string scene_file;
+  std::string output;                    // image path; default: the Film's filename
+  std::optional<int> spp;
+  double time_budget = 0.0;              // seconds, 0 = none
+  int threads = 0;                       // 0 = all cores
+  std::optional<uint32_t> seed;
+  std::string integrator;                // --integrator NAME
+  std::string sampler;                   // --sampler NAME
+  std::optional<std::pair<int, int>> resolution;  // --res WxH
+  std::string stats_file;                // --stats FILE.json
+  bool quiet = false;                    // no progress output
+  std::vector<std::string> plugin_dirs;  // default: Registry::default_search_dirs()
+};
+
+struct RenderStats {
+  double seconds = 0.0;        // rendering only
+  double load_seconds = 0.0;   // parsing, plugin loading, BVH build
+  int spp = 0;
+  uint64_t pixels = 0;
+  uint64_t rays = 0;
+  uint64_t nonfinite_samples = 0;
+  std::optional<std::pair<int, int>> first_nonfinite_pixel;
+  uint64_t peak_memory_bytes = 0;
+  std::vector<std::string> plugins_loaded;
+  std::vector<std::string> structures_built;
+  std::string integrator, sampler, scene_file, output;
+  int threads = 0;
+  uint32_t seed = 0;
+  size_t triangles = 0;
+  double mrays_per_second() const { return seconds > 0 ? rays / seconds * 1e-6 : 0.0; }
+};
+
+struct RenderResult {
+  ImageRgb image;
+  RenderStats stats;
+};
+
+/// Parses, builds and renders. Throws Error for anything the user can fix.
+RenderResult render(const RenderSettings& settings);
+/// Writes the image (and the stats when settings.stats_file is set).
+void write_outputs(const RenderSettings& settings, const RenderResult& result);
+std::string stats_json(const RenderStats& stats);
+
+}  // namespace penumbra

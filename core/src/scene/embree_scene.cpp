@@ -1,0 +1,159 @@
+#include "scene/embree_scene.h"
+
+#include "render/ray_counter.h"
+
+#include <penumbra/error.h>
+
+#include <fmt/core.h>
+
+namespace penumbra {
+
+static void embree_error(void*, RTCError code, const char* message) {
+  throw Error(fmt::format("Embree error {}: {}", static_cast<int>(code), message ? message : ""));
+}
+
+EmbreeScene::EmbreeScene() {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw Error("cannot create an Embree device");
+  rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
+                           std::vector<const Light*> lights) {
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                        RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                        mesh->P.size()));
+  for (size_t i = 0; i < mesh->P.size(); ++i) {
+    v[3 * i] = mesh->P[i].x;
+    v[3 * i + 1] = mesh->P[i].y;
+    v[3 * i + 2] = mesh->P[i].z;
+    bounds_.extend(mesh->P[i]);
+  }
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                                             RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
+                                                             mesh->triangle_count()));
+  std::copy(mesh->indices.begin(), mesh->indices.end(), idx);
+  rtcCommitGeometry(geom);
+  unsigned id = rtcAttachGeometry(scene_, geom);
+  rtcReleaseGeometry(geom);
+  if (geometries_.size() <= id) geometries_.resize(id + 1);
+  geometries_[id] = Geometry{mesh.get(), nullptr, bsdf, std::move(lights)};
+  meshes_.push_back(std::move(mesh));
+}
+
+void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light) {
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                        RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+  Vec3 c = sphere->center();
+  v[0] = c.x, v[1] = c.y, v[2] = c.z, v[3] = sphere->radius();
+  bounds_.extend(c - Vec3(sphere->radius()));
+  bounds_.extend(c + Vec3(sphere->radius()));
+  rtcCommitGeometry(geom);
+  unsigned id = rtcAttachGeometry(scene_, geom);
+  rtcReleaseGeometry(geom);
+  if (geometries_.size() <= id) geometries_.resize(id + 1);
+  std::vector<const Light*> lights;
+  if (light) lights.push_back(light);
+  geometries_[id] = Geometry{nullptr, sphere.get(), bsdf, std::move(lights)};
+  spheres_.push_back(std::move(sphere));
+}
+
+void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const Light*> infinite) {
+  lights_ = std::move(lights);
+  infinite_ = std::move(infinite);
+  std::vector<float> power;
+  for (size_t i = 0; i < lights_.size(); ++i) {
+    const_cast<Light*>(lights_[i])->set_index(static_cast<uint32_t>(i));
+    power.push_back(std::max(0.f, luminance(lights_[i]->power())));
+  }
+  if (!lights_.empty()) light_distribution_ = Distribution1D(power);
+}
+
+void EmbreeScene::commit() { rtcCommitScene(scene_); }
+
+size_t EmbreeScene::triangle_count() const {
+  size_t n = 0;
+  for (const auto& m : meshes_) n += m->triangle_count();
+  return n;
+}
+
+std::optional<SampledLight> EmbreeScene::sample_light(float u) const {
+  if (lights_.empty()) return std::nullopt;
+  float pmf = 0.f;
+  size_t i = light_distribution_.sample_discrete(u, &pmf);
+  if (pmf == 0.f) return std::nullopt;
+  return SampledLight{lights_[i], pmf};
+}
+
+float EmbreeScene::light_pmf(const Light* light) const {
+  if (lights_.empty() || !light) return 0.f;
+  return light_distribution_.discrete_pmf(light->index());
+}
+
+static RTCRayHit make_rayhit(const Ray& ray) {
+  RTCRayHit rh;
+  rh.ray.org_x = ray.o.x, rh.ray.org_y = ray.o.y, rh.ray.org_z = ray.o.z;
+  rh.ray.dir_x = ray.d.x, rh.ray.dir_y = ray.d.y, rh.ray.dir_z = ray.d.z;
+  rh.ray.tnear = 0.f;
+  rh.ray.tfar = ray.tmax;
+  rh.ray.time = 0.f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
+std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
+  count_ray();
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh = make_rayhit(ray);
+  rtcIntersect1(scene_, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+
+  const Geometry& g = geometries_[rh.hit.geomID];
+  SurfaceInteraction si;
+  si.t = rh.ray.tfar;
+  si.wo = -glm::normalize(ray.d);
+  si.shape_id = rh.hit.geomID;
+  si.prim_id = rh.hit.primID;
+  si.bsdf = g.bsdf;
+  if (!g.lights.empty()) si.area_light = g.lights[g.sphere ? 0 : rh.hit.primID];
+  if (g.mesh) {
+    // The hit point comes from the barycentrics: its error does not grow with t.
+    Vec3 b(1.f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v);
+    si.p = g.mesh->position(rh.hit.primID, b);
+    si.ng = g.mesh->geometric_normal(rh.hit.primID, b);
+    Vec3 ns = g.mesh->shading_normal(rh.hit.primID, b);
+    si.ns = ns == Vec3(0.f) ? si.ng : ns;
+    si.uv = g.mesh->uv_at(rh.hit.primID, b);
+  } else {
+    si.p = g.sphere->reproject(ray.o + si.t * ray.d);
+    si.ng = si.ns = g.sphere->normal_at(si.p);
+    si.uv = g.sphere->uv_at(si.p);
+  }
+  si.shading = Frame(si.ns);
+  return si;
+}
+
+bool EmbreeScene::occluded(const Ray& ray) const {
+  count_ray();
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRay r = make_rayhit(ray).ray;
+  rtcOccluded1(scene_, &ctx, &r);
+  return r.tfar < 0.f;
+}
+
+}  // namespace penumbra

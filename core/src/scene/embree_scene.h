@@ -1,0 +1,71 @@
+// The renderable scene: Embree 3 geometry (triangle meshes and native sphere points) plus what a hit
+// needs to become a SurfaceInteraction (material, area lights, orientation).
+#pragma once
+
+#include <penumbra/bsdf.h>
+#include <penumbra/sampling.h>
+#include <penumbra/scene.h>
+
+#include "scene/sphere.h"
+#include "scene/triangle_mesh.h"
+
+#include <embree3/rtcore.h>
+
+#include <memory>
+#include <vector>
+
+namespace penumbra {
+
+class EmbreeScene final : public Scene {
+ public:
+  EmbreeScene();
+  ~EmbreeScene() override;
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  /// Adds a mesh; `lights` is empty or holds one area light per triangle.
+  void add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf, std::vector<const Light*> lights);
+  void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light);
+  /// Meshes and spheres kept for area lights to reference before commit().
+  const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
+
+  /// Keeps the per-triangle shapes that area lights refer to alive as long as the scene.
+  void adopt_shapes(std::vector<std::unique_ptr<Triangle>> shapes) { light_shapes_ = std::move(shapes); }
+  void set_lights(std::vector<const Light*> lights, std::vector<const Light*> infinite);
+  void set_camera(std::unique_ptr<Camera> camera) { camera_ = std::move(camera); }
+  /// Builds the BVH. Call once, after all geometry was added.
+  void commit();
+
+  std::optional<SurfaceInteraction> intersect(const Ray& ray) const override;
+  bool occluded(const Ray& ray) const override;
+  std::span<const Light* const> lights() const override { return lights_; }
+  std::span<const Light* const> infinite_lights() const override { return infinite_; }
+  std::optional<SampledLight> sample_light(float u) const override;
+  float light_pmf(const Light* light) const override;
+  const Camera& camera() const override { return *camera_; }
+  Bounds3 bounds() const override { return bounds_; }
+
+  size_t triangle_count() const;
+  RTCScene rtc_scene() const { return scene_; }
+
+ private:
+  struct Geometry {
+    const TriangleMesh* mesh = nullptr;  // one of these two
+    const Sphere* sphere = nullptr;
+    const Bsdf* bsdf = nullptr;
+    std::vector<const Light*> lights;    // per primitive, or empty
+  };
+
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+  std::vector<std::unique_ptr<TriangleMesh>> meshes_;
+  std::vector<std::unique_ptr<Sphere>> spheres_;
+  std::vector<std::unique_ptr<Triangle>> light_shapes_;
+  std::vector<Geometry> geometries_;  // indexed by Embree geometry id
+  std::vector<const Light*> lights_, infinite_;
+  Distribution1D light_distribution_;  // over lights_, proportional to luminance of power
+  std::unique_ptr<Camera> camera_;
+  Bounds3 bounds_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,244 @@
+#include "scene/scene_builder.h"
+
+#include "parser/ply_reader.h"
+#include "scene/perspective_camera.h"
+
+#include <fmt/core.h>
+
+#include <filesystem>
+
+namespace penumbra {
+
+namespace {
+
+const ParamSpec kTriangleMeshParams[] = {
+    {"point3[]", "P", "", "vertex positions"},
+    {"integer[]", "indices", "", "three vertex indices per triangle (optional for a single triangle)"},
+    {"normal[]", "N", "", "per-vertex shading normals"},
+    {"point2[]", "uv", "", "per-vertex texture coordinates"},
+    {"unsupported", "S", "", "tangents are not used"},
+    {"unsupported", "faceIndices", "", ""},
+    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+};
+const ParamSpec kPlyMeshParams[] = {
+    {"string", "filename", "", "PLY file (ASCII or binary; triangles and polygons)"},
+    {"unsupported", "displacement", "", "displacement is not supported"},
+    {"unsupported", "edgelength", "", "displacement is not supported"},
+    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+};
+const ParamSpec kSphereParams[] = {
+    {"float", "radius", "1", "radius in object space"},
+    {"float", "zmin", "", "must cover the full sphere (partial spheres are not supported)"},
+    {"float", "zmax", "", "must cover the full sphere (partial spheres are not supported)"},
+    {"float", "phimax", "360", "must be 360 (partial spheres are not supported)"},
+    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+};
+
+std::string folder_of(const std::string& path) {
+  return std::filesystem::path(path).parent_path().string();
+}
+
+std::string resolve(const std::string& base_dir, const std::string& file) {
+  std::filesystem::path p(file);
+  return p.is_absolute() || base_dir.empty() ? file : (std::filesystem::path(base_dir) / p).string();
+}
+
+bool swaps_handedness(const Mat4& m) { return glm::determinant(glm::mat3(m)) < 0.f; }
+
+// Moves the mesh to world space and checks it: every index in range, array sizes consistent.
+std::unique_ptr<TriangleMesh> make_mesh(const ShapeEntity& e, std::vector<Vec3> P, std::vector<int> idx,
+                                        std::vector<Vec3> N, std::vector<Vec2> uv, const FileLoc& idx_loc,
+                                        const FileLoc& n_loc, const FileLoc& uv_loc) {
+  if (P.empty()) throw Error(e.loc, "triangle mesh has no vertices");
+  if (idx.empty()) {
+    if (P.size() != 3)
+      throw Error(e.loc, fmt::format("triangle mesh has {} vertices and no \"indices\"", P.size()));
+    idx = {0, 1, 2};
+  }
+  if (idx.size() % 3 != 0)
+    throw Error(idx_loc, fmt::format("\"indices\" has {} values, not a multiple of 3", idx.size()));
+  for (size_t i = 0; i < idx.size(); ++i)
+    if (idx[i] < 0 || static_cast<size_t>(idx[i]) >= P.size())
+      throw Error(idx_loc, fmt::format("index {} (value {}) is out of range: the mesh has {} vertices",
+                                       i, idx[i], P.size()));
+  if (!N.empty() && N.size() != P.size())
+    throw Error(n_loc, fmt::format("\"N\" has {} normals for {} vertices", N.size(), P.size()));
+  if (!uv.empty() && uv.size() != P.size())
+    throw Error(uv_loc, fmt::format("\"uv\" has {} values for {} vertices", uv.size(), P.size()));
+
+  auto mesh = std::make_unique<TriangleMesh>();
+  const Mat4& m = e.to_world;
+  glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
+  mesh->P.reserve(P.size());
+  for (const Vec3& p : P) mesh->P.push_back(Vec3(m * Vec4(p, 1.f)));
+  for (const Vec3& n : N) {
+    Vec3 w = normal_matrix * n;
+    float len = glm::length(w);
+    w = len > 0.f ? w / len : w;
+    mesh->N.push_back(e.reverse_orientation ? -w : w);
+  }
+  mesh->uv = std::move(uv);
+  mesh->indices.assign(idx.begin(), idx.end());
+  mesh->flip_normal = e.reverse_orientation != swaps_handedness(m);
+  for (const Vec3& p : mesh->P)
+    if (!is_finite(p)) throw Error(e.loc, "triangle mesh has a non-finite vertex position");
+  return mesh;
+}
+
+std::unique_ptr<TriangleMesh> load_mesh(ShapeEntity& e) {
+  if (e.type == "trianglemesh") {
+    e.params.validate(kTriangleMeshParams, "shape 'trianglemesh'");
+    return make_mesh(e, e.params.get_point3s("P"), e.params.get_ints("indices"),
+                     e.params.get_point3s("N"), e.params.get_point2s("uv"), e.params.loc_of("indices"),
+                     e.params.loc_of("N"), e.params.loc_of("uv"));
+  }
+  e.params.validate(kPlyMeshParams, "shape 'plymesh'");
+  std::string file = e.params.get_string("filename");
+  if (file.empty()) throw Error(e.loc, "plymesh needs \"string filename\"");
+  FileLoc loc = e.params.loc_of("filename");
+  TriangleMeshData data = read_ply(resolve(e.base_dir, file), loc);
+  return make_mesh(e, std::move(data.P), std::move(data.indices), std::move(data.N),
+                   std::move(data.uv), loc, loc, loc);
+}
+
+std::unique_ptr<Sphere> load_sphere(ShapeEntity& e) {
+  e.params.validate(kSphereParams, "shape 'sphere'");
+  float r = e.params.get_float("radius");
+  if (!(r > 0.f)) throw Error(e.params.loc_of("radius"), "sphere radius must be > 0");
+  if ((e.params.has("zmin") && e.params.get_float("zmin") > -r) ||
+      (e.params.has("zmax") && e.params.get_float("zmax") < r) || e.params.get_float("phimax") < 360.f)
+    throw Error(e.loc, "partial spheres (zmin, zmax, phimax) are not supported");
+  // Only similarity transforms keep a sphere a sphere.
+  const Mat4& m = e.to_world;
+  Vec3 c0(m[0]), c1(m[1]), c2(m[2]);
+  float s0 = glm::length(c0), s1 = glm::length(c1), s2 = glm::length(c2);
+  float tol = 1e-4f * std::max({s0, s1, s2});
+  if (std::abs(s0 - s1) > tol || std::abs(s0 - s2) > tol || std::abs(glm::dot(c0, c1)) > tol * s0 ||
+      std::abs(glm::dot(c0, c2)) > tol * s0 || std::abs(glm::dot(c1, c2)) > tol * s0 || m[0][3] != 0.f ||
+      m[1][3] != 0.f || m[2][3] != 0.f)
+    throw Error(e.loc, "a sphere under a non-uniform scale, shear or projection is not supported");
+  return std::make_unique<Sphere>(m, r, e.reverse_orientation != swaps_handedness(m));
+}
+
+}  // namespace
+
+BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
+  BuiltScene out;
+
+  // Film, filter and camera are part of the core.
+  if (!desc.film.type.empty() && desc.film.type != "rgb")
+    throw Error(desc.film.loc, fmt::format("unsupported film '{}'; available: rgb", desc.film.type));
+  desc.film.params.validate(film_rgb_params(), "film 'rgb'");
+  Point2i res(desc.film.params.get_int("xresolution"), desc.film.params.get_int("yresolution"));
+  if (res.x <= 0 || res.y <= 0 || res.x > 65536 || res.y > 65536)
+    throw Error(desc.film.loc, fmt::format("film resolution {}x{} is out of range", res.x, res.y));
+  out.output_filename = desc.film.params.get_string("filename");
+
+  std::string filter_type = desc.filter.type.empty() ? kDefaultFilter : desc.filter.type;
+  if (pixel_filter_params(filter_type).empty())
+    throw Error(desc.filter.loc,
+                fmt::format("unsupported pixel filter '{}'; available: box, gaussian, triangle", filter_type));
+  desc.filter.params.validate(pixel_filter_params(filter_type), fmt::format("filter '{}'", filter_type));
+  out.film = std::make_unique<FilmRgb>(res, PixelFilter(filter_type, desc.filter.params, desc.filter.loc));
+
+  if (!desc.camera.type.empty() && desc.camera.type != "perspective")
+    throw Error(desc.camera.loc,
+                fmt::format("unsupported camera '{}'; available: perspective", desc.camera.type));
+  desc.camera.params.validate(perspective_camera_params(), "camera 'perspective'");
+  auto camera = std::make_unique<PerspectiveCamera>(desc.camera.params, desc.camera.to_world, res);
+
+  // Sampler and integrator plugins.
+  out.sampler_name = desc.sampler.type.empty() ? kDefaultSampler : desc.sampler.type;
+  out.sampler = registry.create<Sampler>(PluginKind::Sampler, out.sampler_name, desc.sampler.params,
+                                         CreateContext{desc.sampler.params, {}, desc.sampler.base_dir},
+                                         desc.sampler.loc);
+  out.integrator_name = desc.integrator.type.empty() ? kDefaultIntegrator : desc.integrator.type;
+  out.integrator = registry.create<Integrator>(
+      PluginKind::Integrator, out.integrator_name, desc.integrator.params,
+      CreateContext{desc.integrator.params, {}, desc.integrator.base_dir}, desc.integrator.loc);
+
+  // Materials, in file order; the default one only if some shape needs it.
+  for (auto& m : desc.materials) {
+    if (m.type.empty()) throw Error(m.loc, "material has no type");
+    out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params,
+                                              CreateContext{m.params, {}, m.base_dir}, m.loc));
+  }
+  const Bsdf* default_bsdf = nullptr;
+  ParamSet default_params;
+  auto material_of = [&](const ShapeEntity& s) -> const Bsdf* {
+    if (s.material >= 0) return out.bsdfs[s.material].get();
+    if (!s.material_name.empty()) {
+      auto it = desc.named_materials.find(s.material_name);
+      if (it == desc.named_materials.end())
+        throw Error(s.material_loc, fmt::format("named material '{}' is not defined", s.material_name));
+      return out.bsdfs[it->second].get();
+    }
+    if (!default_bsdf) {
+      out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, kDefaultMaterial, default_params,
+                                                CreateContext{default_params}, s.loc));
+      default_bsdf = out.bsdfs.back().get();
+    }
+    return default_bsdf;
+  };
+
+  // Shapes and the area lights on them.
+  out.scene = std::make_unique<EmbreeScene>();
+  std::vector<const Light*> all_lights, infinite_lights;
+  auto make_area_light = [&](const ShapeEntity& s, const Shape* shape) -> const Light* {
+    SceneEntity& a = desc.area_lights[s.area_light];
+    auto light = registry.create<Light>(PluginKind::Light, a.type, a.params,
+                                        CreateContext{a.params, {}, a.base_dir, a.to_world, shape,
+                                                      s.reverse_orientation},
+                                        a.loc);
+    if (light->type() != LightType::Area)
+      throw Error(a.loc, fmt::format("light '{}' is not an area light", a.type));
+    out.lights.push_back(std::move(light));
+    all_lights.push_back(out.lights.back().get());
+    return out.lights.back().get();
+  };
+  std::vector<std::unique_ptr<Triangle>> light_triangles;
+  for (auto& s : desc.shapes) {
+    const Bsdf* bsdf = material_of(s);
+    if (s.type == "trianglemesh" || s.type == "plymesh") {
+      std::unique_ptr<TriangleMesh> mesh = load_mesh(s);
+      std::vector<const Light*> lights;
+      if (s.area_light >= 0) {
+        for (uint32_t i = 0; i < mesh->triangle_count(); ++i) {
+          if (mesh->area(i) <= 0.f) {  // degenerate: never hit, never sampled
+            lights.push_back(nullptr);
+            continue;
+          }
+          light_triangles.push_back(std::make_unique<Triangle>(mesh.get(), i));
+          lights.push_back(make_area_light(s, light_triangles.back().get()));
+        }
+      }
+      out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights));
+    } else if (s.type == "sphere") {
+      std::unique_ptr<Sphere> sphere = load_sphere(s);
+      const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get()) : nullptr;
+      out.scene->add_sphere(std::move(sphere), bsdf, light);
+    } else {
+      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: plymesh, sphere, trianglemesh", s.type));
+    }
+  }
+  out.scene->adopt_shapes(std::move(light_triangles));
+
+  for (auto& l : desc.lights) {
+    auto light = registry.create<Light>(PluginKind::Light, l.type, l.params,
+                                        CreateContext{l.params, {}, l.base_dir, l.to_world}, l.loc);
+    if (light->type() == LightType::Area)
+      throw Error(l.loc, fmt::format("'{}' is an area light: use AreaLightSource", l.type));
+    if (light->type() == LightType::Infinite) infinite_lights.push_back(light.get());
+    out.lights.push_back(std::move(light));
+    all_lights.push_back(out.lights.back().get());
+  }
+
+  out.scene->set_camera(std::move(camera));
+  out.scene->commit();
+  out.structures_built.push_back("embree_scene");
+  out.scene->set_lights(all_lights, infinite_lights);
+  if (!all_lights.empty()) out.structures_built.push_back("light_power_distribution");
+  return out;
+}
+
+}  // namespace penumbra

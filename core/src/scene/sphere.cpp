@@ -1,0 +1,85 @@
+#include "scene/sphere.h"
+
+#include <penumbra/sampling.h>
+
+namespace penumbra {
+
+Sphere::Sphere(const Mat4& m, float radius, bool inward) : inward_(inward) {
+  center_ = Vec3(m[3]);
+  float scale = glm::length(Vec3(m[0]));
+  radius_ = radius * scale;
+  world_to_object_rotation_ = glm::transpose(glm::mat3(m) / scale);
+}
+
+Vec3 Sphere::normal_at(const Vec3& p) const {
+  Vec3 n = glm::normalize(p - center_);
+  return inward_ ? -n : n;
+}
+
+Vec3 Sphere::reproject(const Vec3& p) const {
+  Vec3 d = p - center_;
+  return center_ + d * (radius_ / glm::length(d));
+}
+
+Vec2 Sphere::uv_at(const Vec3& p) const {
+  Vec3 q = world_to_object_rotation_ * glm::normalize(p - center_);
+  float phi = std::atan2(q.y, q.x);
+  if (phi < 0.f) phi += 2.f * Pi;
+  float theta = std::acos(std::clamp(q.z, -1.f, 1.f));
+  return Vec2(phi * Inv2Pi, 1.f - theta * InvPi);
+}
+
+ShapeSample Sphere::sample_area(Vec2 u) const {
+  Vec3 p = center_ + radius_ * sample_uniform_sphere(u);
+  return ShapeSample{p, normal_at(p), uv_at(p), 1.f / area()};
+}
+
+// Cone sampling (pbrt's approach): the cone of directions from ctx.p that hit the sphere is sampled
+// uniformly and the point on the sphere is found geometrically, which avoids a ray-sphere test.
+std::optional<ShapeSample> Sphere::sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const {
+  Vec3 to_center = center_ - ctx.p;
+  float dc2 = glm::dot(to_center, to_center);
+  if (dc2 <= radius_ * radius_ * 1.0001f) {  // inside (or on) the sphere: sample by area
+    ShapeSample s = sample_area(u);
+    s.pdf = area_to_solid_angle_pdf(s.pdf, ctx.p, s.p, s.n);
+    if (!(s.pdf > 0.f) || std::isinf(s.pdf)) return std::nullopt;
+    return s;
+  }
+  float dc = std::sqrt(dc2);
+  float sin2_max = radius_ * radius_ / dc2;
+  float cos_max = safe_sqrt(1.f - sin2_max);
+  float one_minus_cos_max = 1.f - cos_max;
+  float cos_theta = (cos_max - 1.f) * u.x + 1.f;
+  float sin2_theta = 1.f - cos_theta * cos_theta;
+  // For cones under 1.5 degrees, 1 - cos loses its precision in float: use the Taylor series.
+  if (sin2_max < 0.00068523f) {
+    sin2_theta = sin2_max * u.x;
+    cos_theta = std::sqrt(1.f - sin2_theta);
+    one_minus_cos_max = sin2_max / 2.f;
+  }
+  // Angle alpha from the sphere centre to the sampled point.
+  float cos_alpha = sin2_theta / std::sqrt(sin2_max) +
+                    cos_theta * safe_sqrt(1.f - sin2_theta / sin2_max);
+  float sin_alpha = safe_sqrt(1.f - cos_alpha * cos_alpha);
+  float phi = u.y * 2.f * Pi;
+  Frame frame(-to_center / dc);  // frame around the direction from the centre to ctx.p
+  Vec3 n_obj = frame.to_world(Vec3(sin_alpha * std::cos(phi), sin_alpha * std::sin(phi), cos_alpha));
+  Vec3 p = center_ + radius_ * n_obj;
+  ShapeSample s{p, inward_ ? -n_obj : n_obj, uv_at(p), 1.f / (2.f * Pi * one_minus_cos_max)};
+  return s;
+}
+
+float Sphere::pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
+                              const Vec3& n_hit) const {
+  Vec3 to_center = center_ - ctx.p;
+  float dc2 = glm::dot(to_center, to_center);
+  if (dc2 <= radius_ * radius_ * 1.0001f) {
+    float pdf = area_to_solid_angle_pdf(1.f / area(), ctx.p, p_hit, n_hit);
+    return std::isinf(pdf) ? 0.f : pdf;
+  }
+  float sin2_max = radius_ * radius_ / dc2;
+  float one_minus_cos_max = sin2_max < 0.00068523f ? sin2_max / 2.f : 1.f - safe_sqrt(1.f - sin2_max);
+  return 1.f / (2.f * Pi * one_minus_cos_max);
+}
+
+}  // namespace penumbra

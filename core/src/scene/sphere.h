@@ -1,0 +1,35 @@
+// Full spheres, placed by a similarity transform (rotation, uniform scale, translation). Embree
+// intersects them with its native sphere primitive; this class samples and parameterises them.
+#pragma once
+
+#include <penumbra/shape.h>
+
+namespace penumbra {
+
+class Sphere final : public Shape {
+ public:
+  /// `object_to_world` must be a similarity transform; `inward` flips the normal inside.
+  Sphere(const Mat4& object_to_world, float radius, bool inward);
+  Vec3 center() const { return center_; }
+  float radius() const { return radius_; }
+  /// Normal at a point on the surface, oriented (outward unless ReverseOrientation).
+  Vec3 normal_at(const Vec3& p) const;
+  /// Moves a point near the surface exactly onto it (removes the error of o + t d).
+  Vec3 reproject(const Vec3& p) const;
+  Vec2 uv_at(const Vec3& p) const;
+
+  float area() const override { return 4.f * Pi * radius_ * radius_; }
+  ShapeSample sample_area(Vec2 u) const override;
+  /// Uniform within the cone the sphere subtends from outside; by area from inside.
+  std::optional<ShapeSample> sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const override;
+  float pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
+                        const Vec3& n_hit) const override;
+
+ private:
+  Vec3 center_;
+  float radius_;
+  bool inward_;
+  glm::mat3 world_to_object_rotation_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,41 @@
+// Triangle meshes in world space, and their triangles as sampleable shapes for area lights.
+#pragma once
+
+#include <penumbra/shape.h>
+
+#include <vector>
+
+namespace penumbra {
+
+struct TriangleMesh {
+  std::vector<Vec3> P;       // world-space positions
+  std::vector<Vec3> N;       // world-space shading normals (optional), already flipped by ReverseOrientation
+  std::vector<Vec2> uv;      // optional
+  std::vector<uint32_t> indices;
+  bool flip_normal = false;  // ReverseOrientation xor a handedness-swapping transform (used without N)
+
+  size_t triangle_count() const { return indices.size() / 3; }
+  /// Geometric normal of triangle i, oriented by pbrt's rules (towards N when given, else by the
+  /// winding, flipped by flip_normal).
+  Vec3 geometric_normal(size_t i, const Vec3& b) const;
+  Vec3 shading_normal(size_t i, const Vec3& b) const;  // interpolated N, or zero without N
+  Vec2 uv_at(size_t i, const Vec3& b) const;
+  Vec3 position(size_t i, const Vec3& b) const;
+  float area(size_t i) const;
+};
+
+class Triangle final : public Shape {
+ public:
+  Triangle(const TriangleMesh* mesh, uint32_t index) : mesh_(mesh), index_(index) {}
+  float area() const override { return mesh_->area(index_); }
+  ShapeSample sample_area(Vec2 u) const override;
+  std::optional<ShapeSample> sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const override;
+  float pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
+                        const Vec3& n_hit) const override;
+
+ private:
+  const TriangleMesh* mesh_;
+  uint32_t index_;
+};
+
+}  // namespace penumbra

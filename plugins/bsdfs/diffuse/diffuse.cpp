@@ -1,0 +1,53 @@
+// Material "diffuse": Lambertian reflection, f = R / pi, sampled by the cosine-weighted hemisphere
+// on the side of wo.
+//
+// | parameter       | default     | meaning                 |
+// |-----------------|-------------|-------------------------|
+// | rgb reflectance | 0.5 0.5 0.5 | albedo, each in [0, 1]  |
+#include <penumbra/bsdf.h>
+#include <penumbra/plugin.h>
+#include <penumbra/sampling.h>
+
+namespace {
+
+using namespace penumbra;
+
+class DiffuseBsdf final : public Bsdf {
+ public:
+  explicit DiffuseBsdf(Rgb r) : r_(r) {}
+  uint32_t flags() const override { return is_black(r_) ? 0u : (BsdfReflection | BsdfDiffuse); }
+  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
+    return same_hemisphere(wo, wi) ? r_ * InvPi : Rgb(0.f);
+  }
+  std::optional<BsdfSample> sample_f(const Vec3& wo, float, Vec2 u, const ShadingContext&) const override {
+    if (wo.z == 0.f || is_black(r_)) return std::nullopt;
+    Vec3 wi = sample_cosine_hemisphere(u);
+    if (wo.z < 0.f) wi.z = -wi.z;
+    float pdf = cosine_hemisphere_pdf(std::abs(wi.z));
+    if (pdf == 0.f) return std::nullopt;
+    return BsdfSample{r_ * InvPi, wi, pdf, BsdfReflection | BsdfDiffuse};
+  }
+  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
+    return same_hemisphere(wo, wi) ? cosine_hemisphere_pdf(std::abs(wi.z)) : 0.f;
+  }
+
+ private:
+  Rgb r_;
+};
+
+const ParamSpec kParams[] = {
+    {"rgb", "reflectance", "0.5 0.5 0.5", "albedo, each channel in [0, 1]"},
+    {"unsupported", "displacement", "", "displacement is not supported"},
+    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
+};
+
+Object* create(const CreateContext& ctx) {
+  Rgb r = ctx.params.get_rgb("reflectance");
+  if (!(r.r >= 0.f && r.g >= 0.f && r.b >= 0.f && r.r <= 1.f && r.g <= 1.f && r.b <= 1.f))
+    throw Error(ctx.params.loc_of("reflectance"), "reflectance must be in [0, 1] (energy would not be conserved)");
+  return new DiffuseBsdf(r);
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Bsdf, "diffuse", "Lambertian reflection", kParams, create)

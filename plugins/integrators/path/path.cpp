@@ -1,0 +1,144 @@
+// Integrator "path": unidirectional path tracing with next-event estimation, combining light and
+// BSDF sampling by multiple importance sampling (power heuristic), and Russian roulette.
+//
+// | parameter       | default | meaning                                                    |
+// |-----------------|---------|------------------------------------------------------------|
+// | integer maxdepth| 5       | longest path in bounces (0: emitters seen directly only)   |
+// | integer rrdepth | 3       | bounces before Russian roulette may end a path             |
+//
+// Depth convention (pbrt's): a path of depth d has d scattering events between camera and emitter,
+// so maxdepth D sums the series L_e + ... + (throughput)^D L_e exactly.
+//
+// Sample dimensions per bounce are fixed (light choice 1, light point 2, BSDF lobe 1, BSDF
+// direction 2, roulette 1), so quasi-random samplers see the same dimension at every depth.
+#include <penumbra/integrator.h>
+#include <penumbra/plugin.h>
+#include <penumbra/sampling.h>
+
+namespace {
+
+using namespace penumbra;
+
+class PathIntegrator final : public PixelIntegrator {
+ public:
+  PathIntegrator(int max_depth, int rr_depth) : max_depth_(max_depth), rr_depth_(rr_depth) {}
+
+  Rgb Li(const Ray& camera_ray, Sampler& sampler, const Scene& scene) const override {
+    Rgb L(0.f), beta(1.f);
+    Ray ray = camera_ray;
+    bool specular_bounce = false;
+    float bsdf_pdf = 0.f;            // density of the direction that produced `ray`
+    LightSampleContext prev_ctx;     // the vertex that produced `ray`
+
+    for (int depth = 0;; ++depth) {
+      std::optional<SurfaceInteraction> si = scene.intersect(ray);
+      if (!si) {
+        for (const Light* light : scene.infinite_lights()) {
+          Rgb Le = light->Le(ray);
+          if (is_black(Le)) continue;
+          if (depth == 0 || specular_bounce) {
+            L += beta * Le;
+          } else {
+            SurfaceInteraction none;
+            float light_pdf = scene.light_pmf(light) * light->pdf_li(prev_ctx, ray.d, none);
+            L += beta * Le * power_heuristic(1, bsdf_pdf, 1, light_pdf);
+          }
+        }
+        break;
+      }
+
+      // Emission found by the BSDF-sampled ray, weighted against light sampling.
+      if (si->area_light) {
+        Rgb Le = si->area_light->L(si->p, si->ng, si->uv, si->wo);
+        if (!is_black(Le)) {
+          if (depth == 0 || specular_bounce) {
+            L += beta * Le;
+          } else {
+            float light_pdf = scene.light_pmf(si->area_light) * si->area_light->pdf_li(prev_ctx, ray.d, *si);
+            L += beta * Le * power_heuristic(1, bsdf_pdf, 1, light_pdf);
+          }
+        }
+      }
+      if (depth == max_depth_) break;
+
+      const Bsdf& bsdf = *si->bsdf;
+      Vec3 wo = si->shading.to_local(si->wo);
+      ShadingContext sctx{si->uv, TransportMode::Radiance};
+
+      // Next-event estimation (the dimensions are drawn even when unused).
+      float u_light = sampler.get_1d();
+      Vec2 u_light_point = sampler.get_2d();
+      if (bsdf.flags() != 0 && !bsdf.is_specular_only())
+        L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point);
+
+      // Continue the path by sampling the BSDF.
+      float u_lobe = sampler.get_1d();
+      Vec2 u_dir = sampler.get_2d();
+      float u_rr = sampler.get_1d();
+      std::optional<BsdfSample> bs = bsdf.flags() ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
+      if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
+      Vec3 wi = si->shading.to_world(bs->wi);
+      // Reject directions that the shading normal calls reflection but the geometry calls
+      // transmission (and vice versa): they would leak light through the surface.
+      bool reflect_shading = bs->wi.z * wo.z > 0.f;
+      bool reflect_geometric = glm::dot(wi, si->ng) * glm::dot(si->wo, si->ng) > 0.f;
+      if (reflect_shading != reflect_geometric) break;
+      beta *= bs->f * std::abs(bs->wi.z) / bs->pdf;
+      specular_bounce = bs->is_specular();
+      bsdf_pdf = bs->pdf;
+      prev_ctx = LightSampleContext{si->p, si->ng};
+      ray = si->spawn_ray(wi);
+
+      if (depth + 1 >= rr_depth_) {
+        float q = std::max(0.f, 1.f - max_component(beta));
+        if (u_rr < q) break;
+        beta /= 1.f - q;
+      }
+    }
+    return L;
+  }
+
+ private:
+  Rgb sample_direct(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
+                    const Scene& scene, float u_light, Vec2 u) const {
+    std::optional<SampledLight> sl = scene.sample_light(u_light);
+    if (!sl) return Rgb(0.f);
+    LightSampleContext lctx{si.p, si.ng};
+    std::optional<LightLiSample> ls = sl->light->sample_li(lctx, u);
+    if (!ls || !(ls->pdf > 0.f) || is_black(ls->L)) return Rgb(0.f);
+    Vec3 wi = si.shading.to_local(ls->wi);
+    Rgb f = bsdf.f(wo, wi, sctx) * std::abs(wi.z);
+    if (is_black(f)) return Rgb(0.f);
+    // Same leak test as for BSDF sampling, against the geometric normal.
+    if ((wi.z * wo.z > 0.f) != (glm::dot(ls->wi, si.ng) * glm::dot(si.wo, si.ng) > 0.f)) return Rgb(0.f);
+    if (scene.occluded(spawn_ray_to(si.p, si.ng, ls->p_light, ls->n_light))) return Rgb(0.f);
+    float light_pdf = sl->pmf * ls->pdf;
+    if (is_delta_light(sl->light->type())) return f * ls->L / light_pdf;
+    float w = power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
+    return f * ls->L * w / light_pdf;
+  }
+
+  int max_depth_, rr_depth_;
+};
+
+const ParamSpec kParams[] = {
+    {"integer", "maxdepth", "5", "longest path in bounces (0: emitters seen directly only)"},
+    {"integer", "rrdepth", "3", "bounces before Russian roulette may end a path"},
+    {"unsupported", "regularize", "", "path regularisation is not implemented"},
+    {"string", "lightsampler", "power", "light selection: power (the only one so far)"},
+};
+
+Object* create(const CreateContext& ctx) {
+  int max_depth = ctx.params.get_int("maxdepth");
+  if (max_depth < 0) throw Error(ctx.params.loc_of("maxdepth"), "maxdepth must be >= 0");
+  int rr_depth = ctx.params.get_int("rrdepth");
+  if (rr_depth < 1) throw Error(ctx.params.loc_of("rrdepth"), "rrdepth must be >= 1");
+  std::string ls = ctx.params.get_string("lightsampler");
+  if (ls != "power")
+    throw Error(ctx.params.loc_of("lightsampler"), "lightsampler '" + ls + "' is not supported; available: power");
+  return new PathIntegrator(max_depth, rr_depth);
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Integrator, "path", "unidirectional path tracer with next-event estimation and MIS", kParams, create)

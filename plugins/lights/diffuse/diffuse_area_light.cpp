@@ -1,0 +1,67 @@
+// Area light "diffuse": uniform radiance L leaving the front side of a triangle or sphere (both
+// sides with twosided). Sampled through its shape's solid-angle sampling.
+//
+// | parameter     | default | meaning                                      |
+// |---------------|---------|----------------------------------------------|
+// | rgb L         | 1 1 1   | emitted radiance                             |
+// | float scale   | 1       | multiplies L                                 |
+// | bool twosided | false   | emit from both sides of the surface          |
+#include <penumbra/light.h>
+#include <penumbra/plugin.h>
+
+namespace {
+
+using namespace penumbra;
+
+class DiffuseAreaLight final : public Light {
+ public:
+  DiffuseAreaLight(const Shape* shape, Rgb L, bool twosided) : shape_(shape), L_(L), twosided_(twosided) {}
+  LightType type() const override { return LightType::Area; }
+  Rgb power() const override { return L_ * shape_->area() * Pi * (twosided_ ? 2.f : 1.f); }
+
+  Rgb L(const Vec3&, const Vec3& n, const Vec2&, const Vec3& w) const override {
+    if (!twosided_ && glm::dot(n, w) < 0.f) return Rgb(0.f);
+    return L_;
+  }
+
+  std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
+    std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, u);
+    if (!ss || !(ss->pdf > 0.f)) return std::nullopt;
+    Vec3 d = ss->p - ctx.p;
+    float len = glm::length(d);
+    if (len == 0.f) return std::nullopt;
+    Vec3 wi = d / len;
+    Rgb Le = L(ss->p, ss->n, ss->uv, -wi);
+    if (is_black(Le)) return std::nullopt;
+    return LightLiSample{Le, wi, ss->pdf, ss->p, ss->n};
+  }
+
+  float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const SurfaceInteraction& hit) const override {
+    return shape_->pdf_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, wi, hit.p, hit.ng);
+  }
+
+ private:
+  const Shape* shape_;
+  Rgb L_;
+  bool twosided_;
+};
+
+const ParamSpec kParams[] = {
+    {"rgb", "L", "1 1 1", "emitted radiance"},
+    {"float", "scale", "1", "multiplies L"},
+    {"bool", "twosided", "false", "emit from both sides of the surface"},
+    {"unsupported", "filename", "", "image-textured emitters are not supported"},
+    {"unsupported", "power", "", "give the radiance L instead"},
+};
+
+Object* create(const CreateContext& ctx) {
+  if (!ctx.shape) throw Error(ctx.loc, "light 'diffuse' must be used with AreaLightSource before a shape");
+  Rgb L = ctx.params.get_rgb("L") * ctx.params.get_float("scale");
+  if (!(L.r >= 0.f && L.g >= 0.f && L.b >= 0.f) || !is_finite(L))
+    throw Error(ctx.params.loc_of("L"), "emitted radiance must be finite and non-negative");
+  return new DiffuseAreaLight(ctx.shape, L, ctx.params.get_bool("twosided"));
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Light, "diffuse", "area light with uniform radiance", kParams, create)

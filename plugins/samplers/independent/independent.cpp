@@ -1,0 +1,56 @@
+// Sampler "independent" (alias "random"): uniform pseudo-random numbers from PCG32.
+//
+// | parameter            | default | meaning                                  |
+// |----------------------|---------|------------------------------------------|
+// | integer pixelsamples | 16      | samples per pixel                        |
+// | integer seed         | 0       | seed; different seeds give independent images |
+//
+// Each (pixel, seed) pair selects its own PCG32 stream, and sample i of a pixel starts 2^16 values
+// into the stream per index (jump-ahead), so a sample is a pure function of (pixel, index, seed).
+#include <penumbra/plugin.h>
+#include <penumbra/rng.h>
+#include <penumbra/sampler.h>
+
+namespace {
+
+using namespace penumbra;
+
+class IndependentSampler final : public Sampler {
+ public:
+  IndependentSampler(int spp, int seed) : spp_(spp), seed_(seed) {}
+  int samples_per_pixel() const override { return spp_; }
+  void start_pixel_sample(Point2i pixel, uint32_t index, uint32_t dimension) override {
+    rng_.set_sequence(hash_ints(static_cast<uint32_t>(pixel.x), static_cast<uint32_t>(pixel.y),
+                                static_cast<uint64_t>(static_cast<uint32_t>(seed_))),
+                      0);
+    rng_.advance(static_cast<uint64_t>(index) * 65536ull + dimension);
+  }
+  float get_1d() override { return rng_.next_float(); }
+  Vec2 get_2d() override {
+    float x = rng_.next_float();
+    return Vec2(x, rng_.next_float());
+  }
+  Vec2 get_pixel_2d() override { return get_2d(); }
+  std::unique_ptr<Sampler> clone() const override { return std::make_unique<IndependentSampler>(*this); }
+
+ private:
+  int spp_, seed_;
+  Pcg32 rng_;
+};
+
+const ParamSpec kParams[] = {
+    {"integer", "pixelsamples", "16", "samples per pixel"},
+    {"integer", "seed", "0", "seed: different seeds give independent images"},
+};
+
+Object* create(const CreateContext& ctx) {
+  int spp = ctx.params.get_int("pixelsamples");
+  if (spp <= 0) throw Error(ctx.params.loc_of("pixelsamples"), "pixelsamples must be positive");
+  return new IndependentSampler(spp, ctx.params.get_int("seed"));
+}
+
+const char* const kAliases[] = {"random", nullptr};
+
+}  // namespace
+
+PENUMBRA_PLUGIN_WITH_ALIASES(Sampler, "independent", "uniform random samples (PCG32)", kParams, create, kAliases)

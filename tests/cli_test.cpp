@@ -1,0 +1,170 @@
+// The command-line program end to end: renders of the bundled scenes with their stats, overrides,
+// and every class of user error, each with its message, location and exit status 1.
+#include "support/command.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <set>
+
+using namespace penumbra;
+using ::testing::HasSubstr;
+
+namespace {
+
+const std::string kSource = PENUMBRA_SOURCE_DIR;
+
+// A valid minimal scene with `world` inserted after WorldBegin.
+std::string scene_with(const std::string& options, const std::string& world) {
+  return "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\n"
+         "Film \"rgb\" \"integer xresolution\" [ 8 ] \"integer yresolution\" [ 8 ]\n" +
+         options + "WorldBegin\n" + world;
+}
+
+test::CommandResult render_text(const std::string& name, const std::string& text,
+                                std::vector<std::string> extra = {}) {
+  std::string dir = test::temp_dir(name);
+  std::string path = test::write_file(dir, "scene.pbrt", text);
+  std::vector<std::string> args = {"render", path, "-o", dir + "/out.exr", "-q"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return test::run_penumbra(args);
+}
+
+}  // namespace
+
+TEST(Cli, CornellBoxRendersAndStatsListExactlyTheNamedPlugins) {
+  std::string dir = test::temp_dir("cornell");
+  test::CommandResult r = test::run_penumbra({"render", kSource + "/scenes/cornell-box/scene.pbrt", "-o",
+                                              dir + "/cb.exr", "--spp", "8", "--res", "32x32", "--stats",
+                                              dir + "/s.json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto stats = nlohmann::json::parse(test::read_file(dir + "/s.json"));
+  std::set<std::string> plugins(stats["plugins_loaded"].begin(), stats["plugins_loaded"].end());
+  EXPECT_EQ(plugins, (std::set<std::string>{"integrator/path", "sampler/independent", "bsdf/diffuse", "light/diffuse"}));
+  std::set<std::string> built(stats["structures_built"].begin(), stats["structures_built"].end());
+  EXPECT_EQ(built, (std::set<std::string>{"embree_scene", "light_power_distribution"}));
+  EXPECT_EQ(stats["spp"], 8);
+  EXPECT_EQ(stats["pixels"], 32 * 32);
+  EXPECT_EQ(stats["nonfinite_samples"], 0);
+  EXPECT_GT(stats["rays"].get<double>(), 32 * 32 * 8);
+  EXPECT_GT(stats["mrays_per_second"].get<double>(), 0.0);
+  EXPECT_GT(stats["peak_memory_bytes"].get<double>(), 0.0);
+  for (const char* key : {"seconds", "integrator", "sampler", "threads", "seed"}) EXPECT_TRUE(stats.contains(key)) << key;
+  // Progress and a summary go to stderr.
+  EXPECT_THAT(r.err, HasSubstr("wrote " + dir + "/cb.exr"));
+}
+
+TEST(Cli, RealPbrtCornellBoxLoadsUnchangedWithSamplerOverride) {
+  std::string dir = test::temp_dir("pbrt-cornell");
+  test::CommandResult r = test::run_penumbra({"render", kSource + "/scenes/pbrt-v4/cornell-box/scene-v4.pbrt", "-o",
+                                              dir + "/cb.exr", "--sampler", "random", "--spp", "4", "--res",
+                                              "24x24", "--stats", dir + "/s.json", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("warning: Accelerator"));  // accepted with a warning, not an error
+  auto stats = nlohmann::json::parse(test::read_file(dir + "/s.json"));
+  std::set<std::string> plugins(stats["plugins_loaded"].begin(), stats["plugins_loaded"].end());
+  // The scene's "sobol" was never looked up: the override acts first.
+  EXPECT_EQ(plugins, (std::set<std::string>{"integrator/path", "sampler/independent", "bsdf/diffuse", "light/diffuse"}));
+}
+
+TEST(Cli, RealPbrtScenesWithLaterMaterialsFailWithLocatedError) {
+  test::CommandResult r = test::run_penumbra({"render", kSource + "/scenes/pbrt-v4/veach-mis/scene-v4.pbrt",
+                                              "--res", "8x8", "--spp", "1", "--sampler", "random", "-q"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("veach-mis/scene-v4.pbrt:"));
+  EXPECT_THAT(r.err, HasSubstr("error: unknown bsdf 'conductor'; available: diffuse"));
+}
+
+TEST(Cli, NoArgumentsRendersBundledCornellBox) {
+  // Run in a temp folder: the default scene writes its Film filename relative to the working dir.
+  std::string dir = test::temp_dir("noargs");
+  std::string cmd = "cd '" + dir + "' && '" + std::string(PENUMBRA_BINARY) + "' > out.txt 2> err.txt";
+  // Full resolution takes a few seconds on 2 cores; the scene is 256x256 at 64 spp.
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::read_file(dir + "/err.txt");
+  EXPECT_THAT(test::read_file(dir + "/err.txt"), HasSubstr("wrote cornell-box.png"));
+}
+
+TEST(Cli, UnknownParameterSuggestsTheNearestName) {
+  auto r = render_text("maxdeph", scene_with("Integrator \"path\" \"integer maxdeph\" [ 3 ]\n", ""));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:20: error: unknown parameter 'maxdeph' for integrator 'path'; did you mean 'maxdepth'?"));
+  EXPECT_THAT(r.err, HasSubstr("^"));  // the line is quoted with a caret
+}
+
+TEST(Cli, WrongParameterTypeIsLocated) {
+  auto r = render_text("type", scene_with("Integrator \"path\" \"float maxdepth\" [ 3 ]\n", ""));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:20: error: parameter 'maxdepth' of integrator 'path' must have type 'integer', not 'float'"));
+}
+
+TEST(Cli, WrongValueCountIsLocated) {
+  auto r = render_text("count", scene_with("", "Material \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 ]\n"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:20: error: parameter 'reflectance' of bsdf 'diffuse' takes 3 values, got 2"));
+}
+
+TEST(Cli, UnknownPluginListsAvailable) {
+  auto r = render_text("plugin", scene_with("Integrator \"volpath\"\n", ""));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:1: error: unknown integrator 'volpath'; available: path"));
+}
+
+TEST(Cli, MissingPlyFileIsLocated) {
+  auto r = render_text("ply", scene_with("", "Shape \"plymesh\" \"string filename\" [ \"nope.ply\" ]\n"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:18: error:"));
+  EXPECT_THAT(r.err, HasSubstr("nope.ply"));
+}
+
+TEST(Cli, EmptyMeshIsAnError) {
+  auto r = render_text("empty", scene_with("", "Shape \"trianglemesh\" \"point3 P\" [ ] \"integer indices\" [ ]\n"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:"));
+  EXPECT_THAT(r.err, HasSubstr("error:"));
+}
+
+TEST(Cli, OutOfRangeIndexIsLocated) {
+  auto r = render_text("index", scene_with("", "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 3 ]\n"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:55: error: index 2 (value 3) is out of range: the mesh has 3 vertices"));
+}
+
+TEST(Cli, UndefinedNamedMaterialIsLocated) {
+  auto r = render_text("named", scene_with("", "NamedMaterial \"gold\"\nShape \"sphere\"\n"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: named material 'gold' is not defined"));
+}
+
+TEST(Cli, UnsupportedShapeIsLocated) {
+  auto r = render_text("disk", scene_with("", "Shape \"disk\"\n"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: unsupported shape 'disk'; available: plymesh, sphere, trianglemesh"));
+}
+
+TEST(Cli, KnownButUnsupportedPbrtParameterSaysSo) {
+  auto r = render_text("iso", "Film \"rgb\" \"float iso\" [ 100 ]\nWorldBegin\n");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:1:12: error: parameter 'iso' of film 'rgb' is not supported by Penumbra"));
+}
+
+TEST(Cli, BadCommandLineOptionsNameTheOption) {
+  auto r = test::run_penumbra({"render", kSource + "/scenes/cornell-box/scene.pbrt", "--res", "big"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--res: expected WIDTHxHEIGHT"));
+  r = test::run_penumbra({"render", kSource + "/scenes/cornell-box/scene.pbrt", "--spp", "-3"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--spp"));
+  r = test::run_penumbra({"render", "/no/such/scene.pbrt"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("/no/such/scene.pbrt"));
+  r = test::run_penumbra({"render", kSource + "/scenes/cornell-box/scene.pbrt", "--integrator", "nope", "-q"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("unknown integrator 'nope'; available: path"));
+}
+
+TEST(Cli, IntegratorOverrideKeepsParametersTheNewPluginTakes) {
+  auto r = render_text("override", scene_with("Integrator \"path\" \"integer maxdepth\" [ 2 ]\n", ""),
+                       {"--integrator", "path", "--spp", "1"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}

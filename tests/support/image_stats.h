@@ -1,0 +1,32 @@
+// Small statistics over rendered images for whole-render tests.
+#pragma once
+
+#include "image/image_io.h"
+
+#include <cmath>
+
+namespace penumbra::test {
+
+inline double mean_channel(const ImageRgb& img, int c) {
+  double s = 0;
+  for (int i = 0; i < img.width * img.height; ++i) s += img.pixels[3 * i + c];
+  return s / (img.width * img.height);
+}
+
+inline double mean_luminance_free(const ImageRgb& img) {
+  return (mean_channel(img, 0) + mean_channel(img, 1) + mean_channel(img, 2)) / 3.0;
+}
+
+inline int count_nonfinite(const ImageRgb& img) {
+  int n = 0;
+  for (float v : img.pixels) n += std::isfinite(v) ? 0 : 1;
+  return n;
+}
+
+inline float max_abs_pixel_deviation(const ImageRgb& img, double expected) {
+  float m = 0;
+  for (float v : img.pixels) m = std::max(m, static_cast<float>(std::abs(v - expected)));
+  return m;
+}
+
+}  // namespace penumbra::test
