@@ -12,6 +12,7 @@
 #include <embree3/rtcore.h>
 #include <fmt/core.h>
 #include <tbb/global_control.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
@@ -51,10 +52,10 @@ RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   std::vector<RTCRayHit> work = rays;
   double t0 = now();
-  tbb::parallel_for(size_t(0), n, size_t(1024), [&](size_t i) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    rtcIntersect1(scene, &ctx, &work[i]);
+    for (size_t i = r.begin(); i < r.end(); ++i) rtcIntersect1(scene, &ctx, &work[i]);
   });
   double t_closest = now() - t0;
 
@@ -77,10 +78,10 @@ RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
     r.mask = 0xFFFFFFFFu;
   }
   t0 = now();
-  tbb::parallel_for(size_t(0), n, size_t(1024), [&](size_t i) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    rtcOccluded1(scene, &ctx, &shadow[i]);
+    for (size_t i = r.begin(); i < r.end(); ++i) rtcOccluded1(scene, &ctx, &shadow[i]);
   });
   double t_shadow = now() - t0;
   return {n / t_closest * 1e-6, n / t_shadow * 1e-6, 2.0 * n / (t_closest + t_shadow) * 1e-6};

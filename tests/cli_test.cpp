@@ -88,14 +88,14 @@ TEST(Cli, NoArgumentsRendersBundledCornellBox) {
 TEST(Cli, UnknownParameterSuggestsTheNearestName) {
   auto r = render_text("maxdeph", scene_with("Integrator \"path\" \"integer maxdeph\" [ 3 ]\n", ""));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:20: error: unknown parameter 'maxdeph' for integrator 'path'; did you mean 'maxdepth'?"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:19: error: unknown parameter 'maxdeph' for integrator 'path'; did you mean 'maxdepth'?"));
   EXPECT_THAT(r.err, HasSubstr("^"));  // the line is quoted with a caret
 }
 
 TEST(Cli, WrongParameterTypeIsLocated) {
   auto r = render_text("type", scene_with("Integrator \"path\" \"float maxdepth\" [ 3 ]\n", ""));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:20: error: parameter 'maxdepth' of integrator 'path' must have type 'integer', not 'float'"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:19: error: parameter 'maxdepth' of integrator 'path' must have type 'integer', not 'float'"));
 }
 
 TEST(Cli, WrongValueCountIsLocated) {
@@ -113,7 +113,7 @@ TEST(Cli, UnknownPluginListsAvailable) {
 TEST(Cli, MissingPlyFileIsLocated) {
   auto r = render_text("ply", scene_with("", "Shape \"plymesh\" \"string filename\" [ \"nope.ply\" ]\n"));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:18: error:"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:17: error: PLY file '"));
   EXPECT_THAT(r.err, HasSubstr("nope.ply"));
 }
 

@@ -44,13 +44,14 @@ RenderResult render_text(const std::string& name, const std::string& text, int t
 }  // namespace
 
 // Furnace: Le = 1, a = 0.5 -> L = 2. 16x16 pixels x 64 spp; maxdepth 200 makes truncation a^201 ~ 0.
-// Tolerance: image mean within 1 %, every pixel within 6 % (per-pixel standard error measured ~1.5 %).
+// Tolerances: the image mean within 1 % (4 standard errors: the per-pixel standard deviation at 64 spp
+// measures 0.079, so the mean of 256 pixels has 0.005), and every pixel within 0.4 (5 sigma).
 TEST(PathIntegrator, FurnaceSphereRendersLeOverOneMinusAlbedo) {
   RenderResult r = render_text("furnace", furnace_scene(0.5f, 1.f, 200));
   EXPECT_EQ(r.stats.nonfinite_samples, 0u);
   EXPECT_EQ(test::count_nonfinite(r.image), 0);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(test::mean_channel(r.image, c), 2.0, 0.02);
-  EXPECT_LT(test::max_abs_pixel_deviation(r.image, 2.0), 0.12);
+  EXPECT_LT(test::max_abs_pixel_deviation(r.image, 2.0), 0.4);
 }
 
 // Higher albedo makes long paths matter: a = 0.8 -> L = 5 (Russian roulette must stay unbiased).

@@ -1,0 +1,144 @@
+// Directives that create scene objects (camera, options, materials, lights, shapes) or that
+// Penumbra accepts and ignores. Objects are only recorded here; the scene builder loads their
+// plugins.
+#include "parser/scene_parser.h"
+
+#include <fmt/core.h>
+
+#include "parser/param_list.h"
+
+namespace penumbra {
+
+Token SceneParser::expect_string(const Token& d, const char* what) {
+  Token t = tok_->next();
+  if (t.kind != TokenKind::String)
+    throw Error(t.loc, fmt::format("{} needs a quoted {}, got {}", d.text, what, describe(t)));
+  return t;
+}
+
+SceneEntity SceneParser::make_entity(const Token& d, const char* what) {
+  std::string type = expect_string(d, what).text;
+  return entity_at(d, std::move(type), parse_param_list(*tok_));
+}
+
+SceneEntity SceneParser::entity_at(const Token& d, std::string type, ParamSet params) {
+  SceneEntity e;
+  e.type = std::move(type);
+  e.params = std::move(params);
+  e.loc = d.loc;
+  e.base_dir = base_dir_;
+  e.to_world = Mat4(state_.ctm);
+  e.reverse_orientation = state_.reverse_orientation;
+  return e;
+}
+
+// pbrt-v4 separates rendering options (before WorldBegin) from the scene (after it); mixing them
+// is an error there, and keeping that rule keeps Penumbra's scenes valid pbrt-v4.
+void SceneParser::require_options(const Token& d) {
+  if (in_world_)
+    throw Error(d.loc, fmt::format("{} must come before WorldBegin (WorldBegin is at {})", d.text,
+                                   world_begin_loc_.str()));
+}
+
+void SceneParser::require_world(const Token& d) {
+  if (!in_world_) throw Error(d.loc, fmt::format("{} must come after WorldBegin", d.text));
+}
+
+void SceneParser::camera(const Token& d) {
+  require_options(d);
+  desc_.camera = make_entity(d, "camera type");
+  glm::dmat4 world_from_camera = glm::inverse(state_.ctm);
+  desc_.camera.to_world = Mat4(world_from_camera);
+  named_coordinate_systems_["camera"] = world_from_camera;
+}
+
+void SceneParser::set_option_entity(const Token& d, SceneEntity& slot, const char* what) {
+  require_options(d);
+  slot = make_entity(d, what);  // the last one given wins, as in pbrt
+}
+
+void SceneParser::film(const Token& d) { set_option_entity(d, desc_.film, "film type"); }
+void SceneParser::pixel_filter(const Token& d) {
+  set_option_entity(d, desc_.filter, "filter type");
+}
+void SceneParser::sampler(const Token& d) { set_option_entity(d, desc_.sampler, "sampler type"); }
+void SceneParser::integrator(const Token& d) {
+  set_option_entity(d, desc_.integrator, "integrator type");
+}
+
+void SceneParser::material(const Token& d) {
+  require_world(d);
+  desc_.materials.push_back(make_entity(d, "material type"));
+  state_.material = static_cast<int>(desc_.materials.size()) - 1;
+  state_.material_name.clear();
+}
+
+void SceneParser::make_named_material(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "material name");
+  if (auto it = desc_.named_materials.find(name.text); it != desc_.named_materials.end())
+    throw Error(name.loc, fmt::format("named material '{}' redefined (first defined at {})",
+                                      name.text, desc_.materials[it->second].loc.str()));
+  ParamSet given = parse_param_list(*tok_);
+  const Param* type = given.find("type");
+  if (!type)
+    throw Error(d.loc,
+                fmt::format("MakeNamedMaterial '{}' needs a \"string type\" parameter", name.text));
+  if (type->type != "string" || type->strings.size() != 1)
+    throw Error(type->loc, "the 'type' of a named material must be one string");
+  ParamSet params;
+  for (const auto& p : given.params())
+    if (p.name != "type") params.add(p);
+  desc_.materials.push_back(entity_at(d, type->strings[0], std::move(params)));
+  desc_.named_materials[name.text] = static_cast<int>(desc_.materials.size()) - 1;
+}
+
+void SceneParser::named_material(const Token& d) {
+  require_world(d);
+  state_.material_name = expect_string(d, "material name").text;
+  state_.material_loc = d.loc;
+  state_.material = -1;
+}
+
+void SceneParser::area_light_source(const Token& d) {
+  require_world(d);
+  desc_.area_lights.push_back(make_entity(d, "area light type"));
+  state_.area_light = static_cast<int>(desc_.area_lights.size()) - 1;
+}
+
+void SceneParser::light_source(const Token& d) {
+  require_world(d);
+  desc_.lights.push_back(make_entity(d, "light type"));
+}
+
+void SceneParser::shape(const Token& d) {
+  require_world(d);
+  ShapeEntity s;
+  static_cast<SceneEntity&>(s) = make_entity(d, "shape type");
+  s.material = state_.material;
+  s.material_name = state_.material_name;
+  s.material_loc = state_.material_loc;
+  s.area_light = state_.area_light;
+  desc_.shapes.push_back(std::move(s));
+}
+
+void SceneParser::reverse_orientation(const Token&) {
+  state_.reverse_orientation = !state_.reverse_orientation;
+}
+
+void SceneParser::accelerator(const Token& d) {
+  warn_once(d, "Accelerator is ignored: Penumbra always uses Embree's BVH");
+  make_entity(d, "accelerator type");
+}
+
+void SceneParser::color_space(const Token& d) {
+  warn_once(d, "ColorSpace is ignored: Penumbra renders in linear Rec.709 (sRGB primaries)");
+  expect_string(d, "color space name");
+}
+
+void SceneParser::option(const Token& d) {
+  warn_once(d, "Option is ignored by Penumbra");
+  parse_param(*tok_);
+}
+
+}  // namespace penumbra

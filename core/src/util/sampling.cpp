@@ -1,0 +1,131 @@
+#include <penumbra/sampling.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace penumbra {
+
+Vec2 sample_uniform_disk_concentric(Vec2 u) {
+  // Shirley-Chiu: concentric squares map to concentric circles, so strata stay compact (unlike the
+  // polar map, which squeezes the square's left edge into the centre).
+  Vec2 o = 2.f * u - Vec2(1.f);
+  if (o.x == 0.f && o.y == 0.f) return Vec2(0.f);
+  float r, phi;
+  if (std::abs(o.x) > std::abs(o.y)) {
+    r = o.x;
+    phi = (Pi / 4.f) * (o.y / o.x);
+  } else {
+    r = o.y;
+    phi = Pi / 2.f - (Pi / 4.f) * (o.x / o.y);
+  }
+  return r * Vec2(std::cos(phi), std::sin(phi));
+}
+
+Vec3 sample_cosine_hemisphere(Vec2 u) {
+  // Malley's method: uniform on the disk, projected up onto the hemisphere, is cosine-distributed.
+  Vec2 d = sample_uniform_disk_concentric(u);
+  return Vec3(d.x, d.y, safe_sqrt(1.f - d.x * d.x - d.y * d.y));
+}
+
+Vec3 sample_uniform_sphere(Vec2 u) {
+  // Archimedes: z is uniform on [-1, 1] for a uniform point on the sphere.
+  float z = 1.f - 2.f * u.x;
+  float r = safe_sqrt(1.f - z * z);
+  float phi = 2.f * Pi * u.y;
+  return Vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+
+Vec3 sample_uniform_cone(Vec2 u, float cos_max) {
+  // cos(theta) is uniform on [cos_max, 1]. Work with t = 1 - cos(theta) so that narrow cones
+  // (cos_max close to 1) keep their precision: 1 - cos^2 would cancel catastrophically.
+  float t = u.x * (1.f - cos_max);
+  float cos_theta = 1.f - t;
+  float sin_theta = safe_sqrt(t * (2.f - t));
+  float phi = 2.f * Pi * u.y;
+  return Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
+}
+
+Vec2 sample_uniform_triangle(Vec2 u) {
+  // Heitz's low-distortion map (used by pbrt-v4): fold the square along its diagonal and shear each
+  // half onto the triangle. Unlike the sqrt map it keeps neighbouring strata neighbours.
+  float b0, b1;
+  if (u.x < u.y) {
+    b0 = u.x / 2.f;
+    b1 = u.y - b0;
+  } else {
+    b1 = u.y / 2.f;
+    b0 = u.x - b1;
+  }
+  return Vec2(b0, b1);
+}
+
+Distribution1D::Distribution1D(std::span<const float> f) : func_(f.size()), cdf_(f.size() + 1) {
+  size_t n = f.size();
+  for (size_t i = 0; i < n; ++i) func_[i] = std::abs(f[i]);
+  // Accumulate in double: environment maps have millions of bins and a float running sum would
+  // drop the small ones entirely.
+  std::vector<double> cdf(n + 1, 0.0);
+  for (size_t i = 0; i < n; ++i) cdf[i + 1] = cdf[i] + double(func_[i]) / double(n);
+  double total = n > 0 ? cdf[n] : 0.0;
+  integral_ = float(total);
+  if (n == 0) return;
+  for (size_t i = 0; i <= n; ++i)
+    cdf_[i] = total > 0.0 ? float(cdf[i] / total) : float(double(i) / double(n));
+  cdf_[n] = 1.f;  // exact, whatever the rounding, so u < 1 always finds a bin
+}
+
+// Largest i in [0, n-1] with cdf[i] <= u. Zero-width bins are never returned for u < 1, because the
+// next bin then also satisfies the condition.
+static size_t find_interval(const std::vector<float>& cdf, float u) {
+  size_t n = cdf.size() - 1;
+  auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
+  size_t i = it == cdf.begin() ? 0 : size_t(it - cdf.begin()) - 1;
+  return std::min(i, n - 1);
+}
+
+float Distribution1D::sample_continuous(float u, float* pdf, size_t* offset) const {
+  size_t n = func_.size();
+  if (n == 0) {  // nothing to sample: report an impossible sample rather than read out of bounds
+    if (pdf) *pdf = 0.f;
+    if (offset) *offset = 0;
+    return 0.f;
+  }
+  size_t o = find_interval(cdf_, u);
+  if (offset) *offset = o;
+  float width = cdf_[o + 1] - cdf_[o];
+  float du = u - cdf_[o];
+  if (width > 0.f) du /= width;
+  // An all-zero function samples uniformly, so its density is 1 (pbrt reports 0 here; we prefer the
+  // density that matches what was actually sampled).
+  if (pdf) *pdf = integral_ > 0.f ? func_[o] / integral_ : 1.f;
+  // Rounding can carry (o + du) / n onto the next bin's start, whose density may be zero: keep the
+  // sample inside the bin whose pdf and offset we report.
+  float x = (float(o) + std::min(du, 1.f)) / float(n);
+  float upper = std::min(float(o + 1) / float(n), 1.f);
+  return x < upper ? x : std::nextafter(upper, 0.f);
+}
+
+size_t Distribution1D::sample_discrete(float u, float* pmf, float* u_remapped) const {
+  if (func_.empty()) {
+    if (pmf) *pmf = 0.f;
+    if (u_remapped) *u_remapped = u;
+    return 0;
+  }
+  size_t o = find_interval(cdf_, u);
+  if (pmf) *pmf = discrete_pmf(o);
+  if (u_remapped) {
+    float width = cdf_[o + 1] - cdf_[o];
+    float r = width > 0.f ? (u - cdf_[o]) / width : 0.f;
+    *u_remapped = std::clamp(r, 0.f, OneMinusEpsilon);
+  }
+  return o;
+}
+
+float Distribution1D::discrete_pmf(size_t i) const {
+  size_t n = func_.size();
+  if (i >= n) return 0.f;
+  if (integral_ <= 0.f) return 1.f / float(n);
+  return func_[i] / (integral_ * float(n));
+}
+
+}  // namespace penumbra

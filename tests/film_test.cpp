@@ -1,0 +1,100 @@
+// The film: filter importance sampling reproduces each filter's shape, accumulation is a weighted
+// mean, and splats from many threads add up exactly.
+#include "image/film_rgb.h"
+#include "image/image_io.h"
+
+#include <penumbra/rng.h>
+
+#include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
+
+using namespace penumbra;
+
+namespace {
+
+// A filter with its default parameters.
+PixelFilter make_filter(const std::string& type) {
+  ParamSet p;
+  p.validate(pixel_filter_params(type), "filter");
+  return PixelFilter(type, p, {});
+}
+
+// Weighted second moment of the sampled offsets, E_w[x^2] = sum w x^2 / sum w, equals the filter's
+// own second moment int f x^2 / int f (computed by quadrature).
+double weighted_second_moment(const PixelFilter& f, int n) {
+  Pcg32 rng(1, 2);
+  double wx2 = 0, w = 0;
+  for (int i = 0; i < n; ++i) {
+    FilterSample s = f.sample(Vec2(rng.next_float(), rng.next_float()));
+    EXPECT_LE(std::abs(s.offset.x), f.radius().x);
+    EXPECT_LE(std::abs(s.offset.y), f.radius().y);
+    wx2 += s.weight * s.offset.x * s.offset.x;
+    w += s.weight;
+  }
+  return wx2 / w;
+}
+
+template <typename F>
+double quadrature_second_moment(F f, float r) {
+  double num = 0, den = 0;
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    double x = -r + (i + 0.5) * 2.0 * r / n;
+    num += f(x) * x * x;
+    den += f(x);
+  }
+  return num / den;
+}
+
+}  // namespace
+
+TEST(PixelFilter, BoxSamplesMatchUniformMoment) {
+  PixelFilter f = make_filter("box");
+  EXPECT_NEAR(weighted_second_moment(f, 200000), 0.25 / 3.0, 2e-3);
+}
+
+TEST(PixelFilter, TriangleSamplesMatchTentMoment) {
+  PixelFilter f = make_filter("triangle");
+  double expected = quadrature_second_moment([](double x) { return std::max(0.0, 2.0 - std::abs(x)); }, 2.f);
+  EXPECT_NEAR(weighted_second_moment(f, 200000), expected, 0.01 * expected);
+}
+
+TEST(PixelFilter, GaussianSamplesMatchTruncatedGaussianMoment) {
+  PixelFilter f = make_filter("gaussian");
+  auto g = [](double x) {
+    auto e = [](double t) { return std::exp(-t * t / (2 * 0.25)); };
+    return std::max(0.0, e(x) - e(1.5));
+  };
+  double expected = quadrature_second_moment(g, 1.5f);
+  EXPECT_NEAR(weighted_second_moment(f, 200000), expected, 0.01 * expected);
+}
+
+TEST(PixelFilter, UnknownFilterIsAnError) {
+  EXPECT_THROW(PixelFilter("mitchell", ParamSet{}, {}), Error);
+}
+
+TEST(FilmRgb, PixelIsWeightedMeanOfItsSamples) {
+  FilmRgb film(Point2i(2, 1), make_filter("box"));
+  film.add_sample(Point2i(0, 0), Rgb(1, 2, 3), 1.f);
+  film.add_sample(Point2i(0, 0), Rgb(3, 2, 1), 3.f);
+  ImageRgb img = film.image(1.0);
+  EXPECT_FLOAT_EQ(img.pixels[0], 2.5f);
+  EXPECT_FLOAT_EQ(img.pixels[1], 2.f);
+  EXPECT_FLOAT_EQ(img.pixels[2], 1.5f);
+  EXPECT_FLOAT_EQ(img.pixels[3], 0.f);  // a pixel with no samples is black, not NaN
+  EXPECT_FALSE(film.has_splats());      // the splat buffer exists only once something splats
+}
+
+TEST(FilmRgb, ConcurrentSplatsAddUpExactly) {
+  FilmRgb film(Point2i(4, 4), make_filter("box"));
+  const int n = 400000;
+  tbb::parallel_for(0, n, [&](int i) { film.add_splat(Vec2(i % 4 + 0.5f, (i / 4) % 4 + 0.5f), Rgb(1.f, 0.5f, 0.25f)); });
+  film.add_splat(Vec2(-1.f, 2.f), Rgb(100.f));  // outside: ignored
+  ImageRgb img = film.image(n / 16.0);
+  ASSERT_TRUE(film.has_splats());
+  for (int i = 0; i < 16; ++i) {
+    EXPECT_DOUBLE_EQ(img.pixels[3 * i], 1.0);
+    EXPECT_DOUBLE_EQ(img.pixels[3 * i + 1], 0.5);
+    EXPECT_DOUBLE_EQ(img.pixels[3 * i + 2], 0.25);
+  }
+}
