@@ -1,6 +1,7 @@
 // Measures, in one run on the same geometry, (1) the path tracer's whole-render ray throughput on the
 // Cornell box and (2) Embree's raw throughput for incoherent closest-hit and shadow rays with no
-// shading, and prints their ratio. Usage: penumbra-bench-render [--threads N] [--spp N] [--res N]
+// shading, and prints their ratio.
+// Usage: penumbra-bench-render [--scene FILE] [--threads N] [--spp N] [--res N]
 #include "parser/scene_description.h"
 #include "registry/registry.h"
 #include "render/render_session.h"
@@ -91,13 +92,14 @@ RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
 
 int main(int argc, char** argv) {
   int spp = 32, res = 256;
+  std::string scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
   std::vector<int> thread_counts = {1, 2};
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--spp")) spp = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--res")) res = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--threads")) thread_counts = {std::atoi(argv[i + 1])};
+    else if (!std::strcmp(argv[i], "--scene")) scene_file = argv[i + 1];
   }
-  std::string scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
   try {
     SceneDescription desc = parse_scene_file(scene_file);
     Registry registry(Registry::default_search_dirs());

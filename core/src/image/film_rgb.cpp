@@ -2,6 +2,8 @@
 
 #include "image/image_io.h"
 
+#include <penumbra/sampling.h>
+
 #include <fmt/core.h>
 
 namespace penumbra {
@@ -54,13 +56,17 @@ PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const 
     sigma_ = params.get_float("sigma");
     if (!(sigma_ > 0.f)) throw Error(params.loc_of("sigma"), "sigma must be > 0");
     for (int axis = 0; axis < 2; ++axis) {
-      const int n = 256;
+      const int n = 4096;
       std::vector<float> f(n);
-      for (int i = 0; i < n; ++i) {
-        float x = radius_[axis] * (2.f * (i + 0.5f) / n - 1.f);
-        f[i] = eval_gaussian(x, radius_[axis]);
+      for (int i = 0; i < n; ++i) f[i] = eval_gaussian(radius_[axis] * (2.f * (i + 0.5f) / n - 1.f), radius_[axis]);
+      Distribution1D fine(f);
+      std::vector<float>& inv = inverse_cdf_[axis];
+      inv.resize(kInverseSize + 1);
+      for (int k = 0; k <= kInverseSize; ++k) {
+        float pdf;
+        float t = k == kInverseSize ? 1.f : fine.sample_continuous(static_cast<float>(k) / kInverseSize, &pdf);
+        inv[k] = (2.f * t - 1.f) * radius_[axis];
       }
-      table_[axis] = Distribution1D(f);
     }
   }
 }
@@ -82,11 +88,13 @@ float PixelFilter::sample_axis(float u, int axis, float* weight) const {
     *weight = 1.f;
     return u < 0.5f ? -r + r * std::sqrt(2.f * u) : r - r * std::sqrt(2.f - 2.f * u);
   }
-  float pdf = 0.f;
-  float t = table_[axis].sample_continuous(u, &pdf);
-  float x = (2.f * t - 1.f) * r;
-  float pdf_x = pdf / (2.f * r);
-  *weight = pdf_x > 0.f ? eval_gaussian(x, r) / pdf_x : 0.f;
+  const std::vector<float>& inv = inverse_cdf_[axis];
+  float t = u * kInverseSize;
+  int k = std::min(static_cast<int>(t), kInverseSize - 1);
+  float width = inv[k + 1] - inv[k];
+  float x = inv[k] + (t - k) * width;
+  // pdf(x) = 1 / (kInverseSize * width) on this interval.
+  *weight = eval_gaussian(x, r) * kInverseSize * width;
   return x;
 }
 

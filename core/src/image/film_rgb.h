@@ -4,7 +4,6 @@
 
 #include <penumbra/film.h>
 #include <penumbra/params.h>
-#include <penumbra/sampling.h>
 
 #include <atomic>
 #include <memory>
@@ -30,7 +29,10 @@ class PixelFilter {
   std::string type_;
   Vec2 radius_;
   float sigma_ = 0.5f;
-  Distribution1D table_[2];  // Gaussian only: tabulated filter per axis
+  // Gaussian only: per axis, the inverse CDF at kInverseSize + 1 evenly spaced probabilities, so a
+  // sample costs one lookup; the density is constant between entries, so f / pdf stays exact.
+  static constexpr int kInverseSize = 1024;
+  std::vector<float> inverse_cdf_[2];
 };
 
 std::span<const ParamSpec> pixel_filter_params(const std::string& type);
