@@ -1,5 +1,6 @@
 // The command-line program end to end: renders of the bundled scenes with their stats, overrides,
 // and every class of user error, each with its message, location and exit status 1.
+#include "image/image_io.h"
 #include "support/command.h"
 
 #include <gmock/gmock.h>
@@ -167,4 +168,23 @@ TEST(Cli, IntegratorOverrideKeepsParametersTheNewPluginTakes) {
   auto r = render_text("override", scene_with("Integrator \"path\" \"integer maxdepth\" [ 2 ]\n", ""),
                        {"--integrator", "path", "--spp", "1"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST(Cli, NonFiniteSamplesAreDiscardedCountedAndReported) {
+  std::string dir = test::temp_dir("nan");
+  std::string scene = test::write_file(dir, "scene.pbrt", scene_with("Integrator \"nan\"\n", ""));
+  auto r = test::run_penumbra({"render", scene, "-o", dir + "/out.exr", "--spp", "16", "--stats", dir + "/s.json", "-q"},
+                              std::string("PENUMBRA_PLUGIN_PATH=") + PENUMBRA_TEST_PLUGIN_DIR);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto stats = nlohmann::json::parse(test::read_file(dir + "/s.json"));
+  // 8x8 pixels x 16 spp = 1024 samples, about 20 % of them non-finite.
+  int64_t n = stats["nonfinite_samples"];
+  EXPECT_GT(n, 100);
+  EXPECT_LT(n, 320);
+  EXPECT_TRUE(stats["first_nonfinite_pixel"].is_array());
+  EXPECT_THAT(r.err, HasSubstr(std::to_string(n) + " non-finite samples were discarded (first at pixel "));
+  // Only finite samples of value 1 reached the film: every pixel is exactly 1.
+  std::string dump = dir + "/out.exr";
+  auto img = read_image(dump);
+  for (float v : img.pixels) EXPECT_FLOAT_EQ(v, 1.f);
 }
