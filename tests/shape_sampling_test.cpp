@@ -1,0 +1,112 @@
+// Solid-angle sampling of the shapes area lights use, against their own pdfs by chi-square: spheres
+// seen from outside (cone sampling, including the Taylor branch for cones under 1.5 degrees) and from
+// inside (area sampling), and triangles (area sampling converted to solid angle).
+#include "scene/sphere.h"
+#include "scene/triangle_mesh.h"
+#include "support/chi_square.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+using namespace penumbra;
+using namespace penumbra::test;
+
+namespace {
+
+constexpr int kTests = 5;
+const double kAlpha = sidak_alpha(0.01, kTests);
+
+// Nearest intersection of the ray (o, w) with the sphere beyond t = 0, in double precision.
+std::optional<Vec3> hit_sphere(const Sphere& s, const Vec3& o, const Vec3& w) {
+  glm::dvec3 oc = glm::dvec3(o) - glm::dvec3(s.center()), d(w);
+  double b = glm::dot(oc, d), c = glm::dot(oc, oc) - double(s.radius()) * s.radius();
+  double disc = b * b - c;
+  if (disc < 0) return std::nullopt;
+  double t = -b - std::sqrt(disc);
+  if (t <= 0) t = -b + std::sqrt(disc);
+  if (t <= 0) return std::nullopt;
+  return Vec3(glm::dvec3(o) + t * d);
+}
+
+ChiSquareResult test_sphere(const Sphere& sphere, const Vec3& ref, double z_min) {
+  ShapeSampleContext ctx{ref, Vec3(0.f)};
+  auto sample = [&](Vec2 u, float) -> std::optional<Vec3> {
+    auto s = sphere.sample_solid_angle(ctx, u);
+    if (!s) return std::nullopt;
+    return glm::normalize(s->p - ref);
+  };
+  auto pdf = [&](const Vec3& w) -> double {
+    auto p = hit_sphere(sphere, ref, w);
+    return p ? sphere.pdf_solid_angle(ctx, w, *p, sphere.normal_at(*p)) : 0.0;
+  };
+  SphereChart chart;
+  chart.z_min = z_min;
+  return chi_square_sphere(sample, pdf, 1000000, 40, 80, 17, chart);
+}
+
+}  // namespace
+
+TEST(SphereSampling, ConeFromOutsideMatchesPdfChiSquare) {
+  Sphere sphere(glm::translate(Mat4(1.f), Vec3(0, 0, 3)), 1.f, false);
+  ChiSquareResult r = test_sphere(sphere, Vec3(0.f), 0.9);
+  EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
+  EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3);
+}
+
+TEST(SphereSampling, TinyConeUsesStableBranchAndMatchesPdfChiSquare) {
+  // sin^2(theta_max) = 4e-4 < sin^2(1.5 deg): the Taylor branch.
+  Sphere sphere(glm::translate(Mat4(1.f), Vec3(0, 0, 1)), 0.02f, false);
+  ChiSquareResult r = test_sphere(sphere, Vec3(0.f), 0.9997);
+  EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
+  EXPECT_NEAR(r.pdf_integral, 1.0, 1e-2);
+}
+
+TEST(SphereSampling, FromInsideSamplesByAreaAndMatchesPdfChiSquare) {
+  Sphere sphere(Mat4(1.f), 1.f, true);
+  ChiSquareResult r = test_sphere(sphere, Vec3(0.1f, -0.2f, 0.5f), -1.0);
+  EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
+  EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3);
+}
+
+TEST(SphereSampling, SampledPointsLieOnTheVisibleSurface) {
+  Sphere sphere(glm::translate(Mat4(1.f), Vec3(0, 0, 3)), 1.f, false);
+  ShapeSampleContext ctx{Vec3(0.f), Vec3(0.f)};
+  for (int i = 0; i < 1000; ++i) {
+    auto s = sphere.sample_solid_angle(ctx, Vec2((i + 0.5f) / 1000.f, std::fmod(i * 0.618034f, 1.f)));
+    ASSERT_TRUE(s);
+    EXPECT_NEAR(glm::distance(s->p, sphere.center()), 1.f, 1e-5f);
+    EXPECT_LE(glm::dot(s->n, s->p), 1e-4f);  // facing the reference point at the origin
+  }
+}
+
+TEST(TriangleSampling, SolidAngleDensityMatchesChiSquare) {
+  TriangleMesh mesh;
+  mesh.P = {Vec3(-1, -0.5f, 1), Vec3(1.5f, -0.3f, 1.2f), Vec3(0.2f, 1.4f, 0.8f)};
+  mesh.indices = {0, 1, 2};
+  Triangle tri(&mesh, 0);
+  ShapeSampleContext ctx{Vec3(0.f), Vec3(0.f)};
+  auto sample = [&](Vec2 u, float) -> std::optional<Vec3> {
+    auto s = tri.sample_solid_angle(ctx, u);
+    if (!s) return std::nullopt;
+    return glm::normalize(s->p);
+  };
+  // Ray-plane intersection and inside test in double precision.
+  auto pdf = [&](const Vec3& w) -> double {
+    glm::dvec3 a(mesh.P[0]), b(mesh.P[1]), c(mesh.P[2]), d(w);
+    glm::dvec3 n = glm::cross(b - a, c - a);
+    double denom = glm::dot(n, d);
+    if (denom == 0) return 0.0;
+    double t = glm::dot(n, a) / denom;
+    if (t <= 0) return 0.0;
+    glm::dvec3 p = t * d;
+    if (glm::dot(glm::cross(b - a, p - a), n) < 0 || glm::dot(glm::cross(c - b, p - b), n) < 0 ||
+        glm::dot(glm::cross(a - c, p - c), n) < 0)
+      return 0.0;
+    return tri.pdf_solid_angle(ctx, w, Vec3(p), mesh.geometric_normal(0, Vec3(1 / 3.f)));
+  };
+  SphereChart chart;
+  chart.z_min = 0.3;
+  ChiSquareResult r = chi_square_sphere(sample, pdf, 1000000, 40, 80, 23, chart);
+  EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
+  EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);
+}
