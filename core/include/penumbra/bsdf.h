@@ -38,6 +38,17 @@ struct BsdfSample {
   bool is_specular() const { return (flags & BsdfSpecular) != 0; }
 };
 
+/// An approximate scattering lobe for a given wo, used by hierarchical Russian roulette to bound
+/// where a BSDF sends most of its energy: an anisotropic GGX-like lobe around `peak` (local frame)
+/// with roughness (alpha_x, alpha_y) along the shading frame's s and t axes, scaled by `coefficient`
+/// (an albedo-like weight). A diffuse lobe reports peak = +z (on wo's side), alpha = 1, cosine = true.
+struct LobeSummary {
+  Vec3 peak{0.f, 0.f, 1.f};
+  float alpha_x = 1.f, alpha_y = 1.f;
+  float coefficient = 0.f;
+  bool cosine = false;  // true for a cosine (Lambertian) lobe rather than a GGX lobe
+};
+
 class Bsdf : public Object {
  public:
   ~Bsdf() override;
@@ -49,6 +60,9 @@ class Bsdf : public Object {
                                              const ShadingContext& ctx) const = 0;
   /// Density with which sample_f() returns wi (0 for specular lobes).
   virtual float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const = 0;
+
+  /// The dominant lobe for wo (see LobeSummary). The default is a cosine lobe with coefficient 1.
+  virtual LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const;
 
   bool is_specular_only() const {
     uint32_t f = flags();

@@ -25,6 +25,14 @@ Camera::~Camera() = default;
 Film::~Film() = default;
 Scene::~Scene() = default;
 
+LobeSummary Bsdf::lobe(const Vec3& wo, const ShadingContext&) const {
+  LobeSummary l;
+  l.peak = Vec3(0.f, 0.f, wo.z < 0.f ? -1.f : 1.f);
+  l.coefficient = 1.f;
+  l.cosine = true;
+  return l;
+}
+
 Rgb Light::L(const Vec3&, const Vec3&, const Vec2&, const Vec3&) const { return Rgb(0.f); }
 Rgb Light::Le(const Ray&) const { return Rgb(0.f); }
 

@@ -30,6 +30,13 @@ class DiffuseBsdf final : public Bsdf {
   float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
     return same_hemisphere(wo, wi) ? cosine_hemisphere_pdf(std::abs(wi.z)) : 0.f;
   }
+  LobeSummary lobe(const Vec3& wo, const ShadingContext&) const override {
+    LobeSummary l;
+    l.peak = Vec3(0.f, 0.f, wo.z < 0.f ? -1.f : 1.f);
+    l.coefficient = max_component(r_);
+    l.cosine = true;
+    return l;
+  }
 
  private:
   Rgb r_;
