@@ -49,6 +49,10 @@ class Light : public Object {
   /// Infinite lights: radiance arriving along a ray that escapes the scene.
   virtual Rgb Le(const Ray& ray) const;
 
+  /// Called once before rendering with the bounds of the scene's geometry (infinite and distant
+  /// lights need them for their power and for placing shadow-ray targets).
+  virtual void preprocess(const Vec3& scene_center, float scene_radius) {}
+
   /// Index in the scene's light list (set by the runtime; used for light-selection pmfs).
   uint32_t index() const { return index_; }
   void set_index(uint32_t i) { index_ = i; }

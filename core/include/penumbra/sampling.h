@@ -55,4 +55,21 @@ class Distribution1D {
   float integral_ = 0.f;
 };
 
+/// Piecewise-constant 2D distribution over an nu x nv grid on [0,1)^2 (row-major f, v = row):
+/// a marginal over rows and a conditional per row (pbrt's PiecewiseConstant2D).
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  Distribution2D(std::span<const float> f, size_t nu, size_t nv);
+  /// A point in [0,1)^2 with density `pdf` (per unit area of the square).
+  Vec2 sample_continuous(Vec2 u, float* pdf) const;
+  /// Density of sample_continuous() at p.
+  float pdf(Vec2 p) const;
+  float integral() const { return marginal_.integral(); }
+
+ private:
+  std::vector<Distribution1D> conditional_;
+  Distribution1D marginal_;
+};
+
 }  // namespace penumbra

@@ -3,30 +3,11 @@
 // values, not radiance.
 #pragma once
 
+#include <penumbra/image.h>
+
 #include <string>
-#include <utility>
-#include <vector>
 
 namespace penumbra {
-
-struct ImageRgb {
-  int width = 0, height = 0;
-  std::vector<float> pixels;  // RGB interleaved, linear Rec.709, row 0 = top
-};
-
-/// Writes by extension: .exr (32-bit float, zip), .hdr (RGBE), .tif/.tiff (32-bit float), .pfm
-/// (float; written by Penumbra, since OpenImageIO 2.4 only reads it), .png/.jpg/.jpeg (8-bit through
-/// the OCIO display `view`; empty means the config's default view, "Standard" in the shipped
-/// config). `metadata` becomes string attributes where the format has room for them (EXR header,
-/// PNG text chunks; PFM and HDR drop them).
-/// Throws Error naming the file for an unknown extension, a malformed image or a failed write.
-void write_image(const std::string& path, const ImageRgb& img,
-                 const std::vector<std::pair<std::string, std::string>>& metadata = {},
-                 const std::string& view = "");
-
-/// Reads any format OpenImageIO knows as float RGB (grey images are replicated, extra channels
-/// dropped). Values are returned as stored: 8-bit files are not linearised.
-ImageRgb read_image(const std::string& path);
 
 /// The OpenColorIO config used for 8-bit output: $OCIO when set, else the shipped config from
 /// <exe dir>/../share/penumbra/ocio/config.ocio or, in a build tree, the source tree's data/ocio.

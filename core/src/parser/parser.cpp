@@ -137,6 +137,21 @@ void SceneParser::parse_file(const fs::path& path, const FileLoc& included_from)
 void SceneParser::include(const Token& d) {
   Token file = expect_string(d, "file name");
   fs::path path(file.text);
+  // Importing a glTF file places its meshes like a Shape "gltf" would (Penumbra's extension).
+  std::string ext = path.extension().string();
+  if (d.text == "Import" && (ext == ".gltf" || ext == ".glb")) {
+    require_world(d);
+    ShapeEntity s;
+    ParamSet params;
+    params.add(Param{"string", "filename", file.loc, {}, {file.text}, {}});
+    static_cast<SceneEntity&>(s) = entity_at(d, "gltf", std::move(params));
+    s.material = state_.material;
+    s.material_name = state_.material_name;
+    s.material_loc = state_.material_loc;
+    s.area_light = state_.area_light;
+    desc_.shapes.push_back(std::move(s));
+    return;
+  }
   if (path.is_relative()) path = fs::path(base_dir_) / path;
   parse_file(path, d.loc);
 }

@@ -15,6 +15,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <climits>
@@ -138,6 +139,10 @@ RenderResult render(const RenderSettings& settings) {
   RenderResult result;
   result.image = built.film->image(session.completed_spp());
   if (built.film->has_splats()) built.structures_built.push_back("film_splat_buffer");
+  for (const Object* o : {static_cast<const Object*>(built.integrator.get()), static_cast<const Object*>(built.sampler.get())})
+    for (auto& name : o->structures_built())
+      if (std::find(built.structures_built.begin(), built.structures_built.end(), name) == built.structures_built.end())
+        built.structures_built.push_back(name);
   RenderStats& s = result.stats;
   s.seconds = seconds;
   s.load_seconds = load_seconds;

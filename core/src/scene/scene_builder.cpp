@@ -1,10 +1,12 @@
 #include "scene/scene_builder.h"
 
 #include "parser/ply_reader.h"
+#include "scene/gltf_loader.h"
 #include "scene/perspective_camera.h"
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
 
 namespace penumbra {
@@ -25,6 +27,9 @@ const ParamSpec kPlyMeshParams[] = {
     {"unsupported", "displacement", "", "displacement is not supported"},
     {"unsupported", "edgelength", "", "displacement is not supported"},
     {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+};
+const ParamSpec kGltfParams[] = {
+    {"string", "filename", "", "glTF 2.0 file (.gltf or .glb): all triangle meshes of its default scene"},
 };
 const ParamSpec kSphereParams[] = {
     {"float", "radius", "1", "radius in object space"},
@@ -181,6 +186,16 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     return default_bsdf;
   };
 
+  // glTF materials become Disney materials with the factors of pbrMetallicRoughness.
+  auto gltf_bsdf = [&](const GltfMaterial& m, const FileLoc& loc) -> const Bsdf* {
+    ParamSet p;
+    p.add(Param{"rgb", "color", loc, {m.base_color.r, m.base_color.g, m.base_color.b}, {}, {}});
+    p.add(Param{"float", "metallic", loc, {m.metallic}, {}, {}});
+    p.add(Param{"float", "roughness", loc, {m.roughness}, {}, {}});
+    out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, "disney", p, CreateContext{p}, loc));
+    return out.bsdfs.back().get();
+  };
+
   // Shapes and the area lights on them.
   out.scene = std::make_unique<EmbreeScene>();
   std::vector<const Light*> all_lights, infinite_lights;
@@ -197,28 +212,39 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     return out.lights.back().get();
   };
   std::vector<std::unique_ptr<Triangle>> light_triangles;
-  for (auto& s : desc.shapes) {
-    const Bsdf* bsdf = material_of(s);
-    if (s.type == "trianglemesh" || s.type == "plymesh") {
-      std::unique_ptr<TriangleMesh> mesh = load_mesh(s);
-      std::vector<const Light*> lights;
-      if (s.area_light >= 0) {
-        for (uint32_t i = 0; i < mesh->triangle_count(); ++i) {
-          if (mesh->area(i) <= 0.f) {  // degenerate: never hit, never sampled
-            lights.push_back(nullptr);
-            continue;
-          }
-          light_triangles.push_back(std::make_unique<Triangle>(mesh.get(), i));
-          lights.push_back(make_area_light(s, light_triangles.back().get()));
+  auto add_mesh = [&](const ShapeEntity& s, std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf) {
+    std::vector<const Light*> lights;
+    if (s.area_light >= 0) {
+      for (uint32_t i = 0; i < mesh->triangle_count(); ++i) {
+        if (mesh->area(i) <= 0.f) {  // degenerate: never hit, never sampled
+          lights.push_back(nullptr);
+          continue;
         }
+        light_triangles.push_back(std::make_unique<Triangle>(mesh.get(), i));
+        lights.push_back(make_area_light(s, light_triangles.back().get()));
       }
-      out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights));
+    }
+    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights));
+  };
+  for (auto& s : desc.shapes) {
+    if (s.type == "trianglemesh" || s.type == "plymesh") {
+      add_mesh(s, load_mesh(s), material_of(s));
+    } else if (s.type == "gltf") {
+      s.params.validate(kGltfParams, "shape 'gltf'");
+      FileLoc loc = s.params.has("filename") ? s.params.loc_of("filename") : s.loc;
+      std::string file = s.params.get_string("filename");
+      if (file.empty()) throw Error(s.loc, "shape 'gltf' needs \"string filename\"");
+      for (GltfPrimitive& g : load_gltf(resolve(s.base_dir, file), loc)) {
+        const Bsdf* bsdf = g.material ? gltf_bsdf(*g.material, s.loc) : material_of(s);
+        add_mesh(s, make_mesh(s, std::move(g.P), std::move(g.indices), std::move(g.N), std::move(g.uv), loc, loc, loc), bsdf);
+      }
     } else if (s.type == "sphere") {
+      const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Sphere> sphere = load_sphere(s);
       const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get()) : nullptr;
       out.scene->add_sphere(std::move(sphere), bsdf, light);
     } else {
-      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: plymesh, sphere, trianglemesh", s.type));
+      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: gltf, plymesh, sphere, trianglemesh", s.type));
     }
   }
   out.scene->adopt_shapes(std::move(light_triangles));
@@ -236,8 +262,20 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   out.scene->set_camera(std::move(camera));
   out.scene->commit();
   out.structures_built.push_back("embree_scene");
+  Bounds3 b = out.scene->bounds();
+  bool empty = b.min.x > b.max.x;
+  Vec3 center = empty ? Vec3(0.f) : 0.5f * (b.min + b.max);
+  float radius = empty ? 1.f : std::max(1e-3f, 0.5f * glm::length(b.max - b.min));
+  for (auto& light : out.lights) light->preprocess(center, radius);
   out.scene->set_lights(all_lights, infinite_lights);
   if (!all_lights.empty()) out.structures_built.push_back("light_power_distribution");
+  auto collect = [&](const Object& o) {
+    for (auto& name : o.structures_built())
+      if (std::find(out.structures_built.begin(), out.structures_built.end(), name) == out.structures_built.end())
+        out.structures_built.push_back(name);
+  };
+  for (auto& l : out.lights) collect(*l);
+  for (auto& m : out.bsdfs) collect(*m);
   return out;
 }
 

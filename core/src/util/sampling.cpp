@@ -128,4 +128,33 @@ float Distribution1D::discrete_pmf(size_t i) const {
   return func_[i] / (integral_ * float(n));
 }
 
+Distribution2D::Distribution2D(std::span<const float> f, size_t nu, size_t nv) {
+  conditional_.reserve(nv);
+  std::vector<float> row_integrals(nv);
+  for (size_t v = 0; v < nv; ++v) {
+    conditional_.emplace_back(f.subspan(v * nu, nu));
+    row_integrals[v] = conditional_.back().integral();
+  }
+  marginal_ = Distribution1D(row_integrals);
+}
+
+Vec2 Distribution2D::sample_continuous(Vec2 u, float* pdf) const {
+  float pdf_v = 0.f, pdf_u = 0.f;
+  size_t row = 0;
+  float v = marginal_.sample_continuous(u.y, &pdf_v, &row);
+  float x = conditional_[row].sample_continuous(u.x, &pdf_u);
+  if (pdf) *pdf = pdf_v * pdf_u;
+  return Vec2(x, v);
+}
+
+float Distribution2D::pdf(Vec2 p) const {
+  if (conditional_.empty()) return 0.f;
+  size_t nu = conditional_[0].size(), nv = conditional_.size();
+  size_t iu = std::min(static_cast<size_t>(std::max(p.x, 0.f) * nu), nu - 1);
+  size_t iv = std::min(static_cast<size_t>(std::max(p.y, 0.f) * nv), nv - 1);
+  // Density = pmf of the cell times the cell count: the marginal's and the conditional's discrete
+  // pmfs already include the all-zero-means-uniform rule.
+  return marginal_.discrete_pmf(iv) * nv * conditional_[iv].discrete_pmf(iu) * nu;
+}
+
 }  // namespace penumbra

@@ -5,6 +5,8 @@
 // |-----------------|---------|------------------------------------------------------------|
 // | integer maxdepth| 5       | longest path in bounces (0: emitters seen directly only)   |
 // | integer rrdepth | 3       | bounces before Russian roulette may end a path             |
+// | string strategy | mis     | "mis": light and BSDF sampling combined; "bsdf": BSDF      |
+// |                 |         | sampling only (emitters count when hit; for comparisons)   |
 //
 // Depth convention (pbrt's): a path of depth d has d scattering events between camera and emitter,
 // so maxdepth D sums the series L_e + ... + (throughput)^D L_e exactly.
@@ -21,7 +23,8 @@ using namespace penumbra;
 
 class PathIntegrator final : public PixelIntegrator {
  public:
-  PathIntegrator(int max_depth, int rr_depth) : max_depth_(max_depth), rr_depth_(rr_depth) {}
+  PathIntegrator(int max_depth, int rr_depth, bool light_sampling)
+      : max_depth_(max_depth), rr_depth_(rr_depth), light_sampling_(light_sampling) {}
 
   Rgb Li(const Ray& camera_ray, Sampler& sampler, const Scene& scene) const override {
     Rgb L(0.f), beta(1.f);
@@ -36,7 +39,7 @@ class PathIntegrator final : public PixelIntegrator {
         for (const Light* light : scene.infinite_lights()) {
           Rgb Le = light->Le(ray);
           if (is_black(Le)) continue;
-          if (depth == 0 || specular_bounce) {
+          if (depth == 0 || specular_bounce || !light_sampling_) {
             L += beta * Le;
           } else {
             SurfaceInteraction none;
@@ -51,7 +54,7 @@ class PathIntegrator final : public PixelIntegrator {
       if (si->area_light) {
         Rgb Le = si->area_light->L(si->p, si->ng, si->uv, si->wo);
         if (!is_black(Le)) {
-          if (depth == 0 || specular_bounce) {
+          if (depth == 0 || specular_bounce || !light_sampling_) {
             L += beta * Le;
           } else {
             float light_pdf = scene.light_pmf(si->area_light) * si->area_light->pdf_li(prev_ctx, ray.d, *si);
@@ -68,7 +71,7 @@ class PathIntegrator final : public PixelIntegrator {
       // Next-event estimation (the dimensions are drawn even when unused).
       float u_light = sampler.get_1d();
       Vec2 u_light_point = sampler.get_2d();
-      if (bsdf.flags() != 0 && !bsdf.is_specular_only())
+      if (light_sampling_ && bsdf.flags() != 0 && !bsdf.is_specular_only())
         L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point);
 
       // Continue the path by sampling the BSDF.
@@ -119,6 +122,7 @@ class PathIntegrator final : public PixelIntegrator {
   }
 
   int max_depth_, rr_depth_;
+  bool light_sampling_;
 };
 
 const ParamSpec kParams[] = {
@@ -126,6 +130,7 @@ const ParamSpec kParams[] = {
     {"integer", "rrdepth", "3", "bounces before Russian roulette may end a path"},
     {"unsupported", "regularize", "", "path regularisation is not implemented"},
     {"string", "lightsampler", "power", "light selection: power (the only one so far)"},
+    {"string", "strategy", "mis", "mis: light + BSDF sampling with MIS; bsdf: BSDF sampling only"},
 };
 
 Object* create(const CreateContext& ctx) {
@@ -136,7 +141,10 @@ Object* create(const CreateContext& ctx) {
   std::string ls = ctx.params.get_string("lightsampler");
   if (ls != "power")
     throw Error(ctx.params.loc_of("lightsampler"), "lightsampler '" + ls + "' is not supported; available: power");
-  return new PathIntegrator(max_depth, rr_depth);
+  std::string strategy = ctx.params.get_string("strategy");
+  if (strategy != "mis" && strategy != "bsdf")
+    throw Error(ctx.params.loc_of("strategy"), "strategy '" + strategy + "' is not supported; available: mis, bsdf");
+  return new PathIntegrator(max_depth, rr_depth, strategy == "mis");
 }
 
 }  // namespace

@@ -1,0 +1,63 @@
+// Writes a synthetic equirectangular sky for the environment-lit scenes: a blue gradient above the
+// horizon, a dim ground below it, and a small, very bright sun disk. The sky that ships in
+// scenes/environment/ was made with `penumbra-make-sky scenes/environment/sky.exr`.
+//
+// Mapping (as the "infinite" light reads it): column u = phi / 2pi, row v = theta / pi, +z up.
+//
+// Usage: penumbra-make-sky OUT.exr [WIDTH HEIGHT SUN_ELEVATION_DEG SUN_AZIMUTH_DEG SUN_RADIANCE]
+#include <penumbra/color.h>
+#include <penumbra/error.h>
+#include <penumbra/image.h>
+#include <penumbra/math.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+using namespace penumbra;
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s OUT.exr [WIDTH HEIGHT SUN_ELEVATION_DEG SUN_AZIMUTH_DEG SUN_RADIANCE]\n", argv[0]);
+    return 1;
+  }
+  int w = argc > 2 ? std::atoi(argv[2]) : 256, h = argc > 3 ? std::atoi(argv[3]) : 128;
+  float elevation = radians(argc > 4 ? std::atof(argv[4]) : 35.f);
+  float azimuth = radians(argc > 5 ? std::atof(argv[5]) : 60.f);
+  float sun_L = argc > 6 ? std::atof(argv[6]) : 1500.f;
+  const float sun_radius = radians(1.6f);  // a little over a texel at 256 x 128, like a small sun
+  if (w < 8 || h < 4) {
+    std::fprintf(stderr, "error: image too small\n");
+    return 1;
+  }
+  Vec3 sun(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+
+  ImageRgb img;
+  img.width = w;
+  img.height = h;
+  img.pixels.resize(3 * static_cast<size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float theta = Pi * (y + 0.5f) / h, phi = 2.f * Pi * (x + 0.5f) / w;
+      Vec3 d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+      Rgb L;
+      if (d.z >= 0.f) {
+        float t = std::pow(d.z, 0.4f);  // zenith blue, whiter towards the horizon
+        L = glm::mix(Rgb(0.9f, 0.95f, 1.05f), Rgb(0.25f, 0.45f, 0.95f), t);
+        float glow = std::max(0.f, glm::dot(d, sun));
+        L += Rgb(1.f, 0.8f, 0.5f) * 0.6f * std::pow(glow, 32.f);  // haze around the sun
+      } else {
+        L = Rgb(0.12f, 0.1f, 0.08f);  // ground
+      }
+      if (std::acos(std::clamp(glm::dot(d, sun), -1.f, 1.f)) < sun_radius) L = Rgb(1.f, 0.92f, 0.8f) * sun_L;
+      float* p = &img.pixels[3 * (static_cast<size_t>(y) * w + x)];
+      p[0] = L.r, p[1] = L.g, p[2] = L.b;
+    }
+  try {
+    write_image(argv[1], img);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "%s\n", e.formatted().c_str());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,50 @@
+// Light "point": an isotropic point source of intensity I (a delta light: sampled, never hit).
+//
+// | parameter    | default | meaning                                   |
+// |--------------|---------|-------------------------------------------|
+// | rgb I        | 1 1 1   | radiant intensity                         |
+// | float scale  | 1       | multiplies I                              |
+// | point3 from  | 0 0 0   | position (before the current transform)   |
+#include <penumbra/light.h>
+#include <penumbra/plugin.h>
+
+namespace {
+
+using namespace penumbra;
+
+class PointLight final : public Light {
+ public:
+  PointLight(Vec3 position, Rgb intensity) : p_(position), I_(intensity) {}
+  LightType type() const override { return LightType::DeltaPosition; }
+  Rgb power() const override { return 4.f * Pi * I_; }
+  std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2) const override {
+    Vec3 d = p_ - ctx.p;
+    float dist2 = glm::dot(d, d);
+    if (dist2 == 0.f) return std::nullopt;  // a point light on the receiving point delivers nothing finite
+    return LightLiSample{I_ / dist2, d / std::sqrt(dist2), 1.f, p_, Vec3(0.f)};
+  }
+  float pdf_li(const LightSampleContext&, const Vec3&, const SurfaceInteraction&) const override { return 0.f; }
+
+ private:
+  Vec3 p_;
+  Rgb I_;
+};
+
+const ParamSpec kParams[] = {
+    {"rgb", "I", "1 1 1", "radiant intensity"},
+    {"float", "scale", "1", "multiplies I"},
+    {"point3", "from", "0 0 0", "position"},
+    {"unsupported", "power", "", "give the intensity I instead"},
+};
+
+Object* create(const CreateContext& ctx) {
+  Rgb I = ctx.params.get_rgb("I") * ctx.params.get_float("scale");
+  if (!(I.r >= 0.f && I.g >= 0.f && I.b >= 0.f) || !is_finite(I))
+    throw Error(ctx.params.loc_of("I"), "intensity must be finite and non-negative");
+  Vec3 from = Vec3(ctx.to_world * Vec4(ctx.params.get_point3("from"), 1.f));
+  return new PointLight(from, I);
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Light, "point", "isotropic point light", kParams, create)
