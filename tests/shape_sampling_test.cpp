@@ -13,7 +13,7 @@ using namespace penumbra::test;
 
 namespace {
 
-constexpr int kTests = 5;
+constexpr int kTests = 6;
 const double kAlpha = sidak_alpha(0.01, kTests);
 
 // Nearest intersection of the ray (o, w) with the sphere beyond t = 0, in double precision.
@@ -79,10 +79,9 @@ TEST(SphereSampling, SampledPointsLieOnTheVisibleSurface) {
   }
 }
 
-TEST(TriangleSampling, SolidAngleDensityMatchesChiSquare) {
-  TriangleMesh mesh;
-  mesh.P = {Vec3(-1, -0.5f, 1), Vec3(1.5f, -0.3f, 1.2f), Vec3(0.2f, 1.4f, 0.8f)};
-  mesh.indices = {0, 1, 2};
+namespace {
+
+ChiSquareResult triangle_chi_square(const TriangleMesh& mesh, double z_min) {
   Triangle tri(&mesh, 0);
   ShapeSampleContext ctx{Vec3(0.f), Vec3(0.f)};
   auto sample = [&](Vec2 u, float) -> std::optional<Vec3> {
@@ -105,8 +104,28 @@ TEST(TriangleSampling, SolidAngleDensityMatchesChiSquare) {
     return tri.pdf_solid_angle(ctx, w, Vec3(p), mesh.geometric_normal(0, Vec3(1 / 3.f)));
   };
   SphereChart chart;
-  chart.z_min = 0.3;
-  ChiSquareResult r = chi_square_sphere(sample, pdf, 1000000, 40, 80, 23, chart);
+  chart.z_min = z_min;
+  return chi_square_sphere(sample, pdf, 1000000, 40, 80, 23, chart);
+}
+
+}  // namespace
+
+// Subtends about 1.1 sr: sampled uniformly in solid angle (Arvo's spherical triangle sampling).
+TEST(TriangleSampling, SphericalSamplingMatchesPdfChiSquare) {
+  TriangleMesh mesh;
+  mesh.P = {Vec3(-1, -0.5f, 1), Vec3(1.5f, -0.3f, 1.2f), Vec3(0.2f, 1.4f, 0.8f)};
+  mesh.indices = {0, 1, 2};
+  ChiSquareResult r = triangle_chi_square(mesh, 0.3);
   EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
   EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);
+}
+
+// Subtends about 5e-5 sr, below the spherical sampler's precision limit: sampled by area.
+TEST(TriangleSampling, SmallDistantTriangleFallsBackToAreaSamplingChiSquare) {
+  TriangleMesh mesh;
+  mesh.P = {Vec3(-0.05f, -0.04f, 10), Vec3(0.06f, -0.03f, 10.2f), Vec3(0.01f, 0.07f, 9.9f)};
+  mesh.indices = {0, 1, 2};
+  ChiSquareResult r = triangle_chi_square(mesh, std::cos(0.012));
+  EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
+  EXPECT_NEAR(r.pdf_integral, 1.0, 5e-3);
 }

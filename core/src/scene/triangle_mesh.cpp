@@ -43,8 +43,73 @@ ShapeSample Triangle::sample_area(Vec2 u) const {
                      mesh_->uv_at(index_, b), 1.f / area()};
 }
 
-// Area sampling converted to solid angle. Spherical-triangle sampling arrives with the lights issue.
+namespace {
+
+// Spherical sampling is used between these solid angles: below, the triangle's spherical angles lose
+// their precision in float; above, it nearly covers a hemisphere and area sampling does as well.
+constexpr float kMinSphericalSolidAngle = 3e-4f, kMaxSphericalSolidAngle = 6.22f;
+
+// Solid angle of the triangle (a, b, c: unit directions) by Van Oosterom and Strackee's formula.
+float solid_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return std::abs(2.f * std::atan2(glm::dot(a, glm::cross(b, c)), 1.f + glm::dot(a, b) + glm::dot(a, c) + glm::dot(b, c)));
+}
+
+float angle_between(const Vec3& x, const Vec3& y) {
+  return std::acos(std::clamp(glm::dot(x, y), -1.f, 1.f));
+}
+
+// The component of v orthogonal to unit w, normalised.
+Vec3 orthonormal_part(const Vec3& v, const Vec3& w) { return glm::normalize(v - glm::dot(v, w) * w); }
+
+// Arvo (1995): a direction uniformly distributed over the spherical triangle abc of area `omega`.
+std::optional<Vec3> sample_spherical_triangle(const Vec3& a, const Vec3& b, const Vec3& c, float omega, Vec2 u) {
+  Vec3 n_ab = glm::cross(a, b), n_ac = glm::cross(a, c), n_bc = glm::cross(b, c);
+  if (glm::dot(n_ab, n_ab) == 0.f || glm::dot(n_ac, n_ac) == 0.f || glm::dot(n_bc, n_bc) == 0.f) return std::nullopt;
+  float alpha = angle_between(glm::normalize(n_ab), glm::normalize(n_ac));  // interior angle at a
+  float cos_c = glm::dot(a, b);                                             // arc length a-b
+  // Choose the sub-triangle a b c' of area u.x * omega: c' lies on the arc from a to c.
+  float area = u.x * omega;
+  float s = std::sin(area - alpha), t = std::cos(area - alpha);
+  float cos_alpha = std::cos(alpha), sin_alpha = std::sin(alpha);
+  float uu = t - cos_alpha, vv = s + sin_alpha * cos_c;
+  float denom = (vv * s + uu * t) * sin_alpha;
+  if (denom == 0.f) return std::nullopt;
+  float q = std::clamp(((vv * t - uu * s) * cos_alpha - vv) / denom, -1.f, 1.f);
+  Vec3 c_prime = q * a + safe_sqrt(1.f - q * q) * orthonormal_part(c, a);
+  // Then a point on the arc from b to c', uniform in solid angle.
+  float z = 1.f - u.y * (1.f - glm::dot(c_prime, b));
+  Vec3 w = z * b + safe_sqrt(1.f - z * z) * orthonormal_part(c_prime, b);
+  if (!is_finite(w)) return std::nullopt;
+  return glm::normalize(w);
+}
+
+}  // namespace
+
+// Uniform in the solid angle the triangle subtends (Arvo's spherical triangle sampling) where that
+// is numerically safe, otherwise uniform in area; pdf_solid_angle() makes the same choice.
 std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const {
+  const uint32_t* v = &mesh_->indices[3 * index_];
+  Vec3 p0 = mesh_->P[v[0]], p1 = mesh_->P[v[1]], p2 = mesh_->P[v[2]];
+  Vec3 a = glm::normalize(p0 - ctx.p), b = glm::normalize(p1 - ctx.p), c = glm::normalize(p2 - ctx.p);
+  float omega = solid_angle(a, b, c);
+  if (omega >= kMinSphericalSolidAngle && omega <= kMaxSphericalSolidAngle) {
+    std::optional<Vec3> w = sample_spherical_triangle(a, b, c, omega, u);
+    if (!w) return std::nullopt;
+    // Where the direction meets the triangle: barycentrics by Cramer's rule (Moeller-Trumbore).
+    Vec3 e1 = p1 - p0, e2 = p2 - p0, s1 = glm::cross(*w, e2);
+    float divisor = glm::dot(s1, e1);
+    if (divisor == 0.f) return std::nullopt;
+    Vec3 d = ctx.p - p0;
+    float b1 = std::clamp(glm::dot(d, s1) / divisor, 0.f, 1.f);
+    float b2 = std::clamp(glm::dot(*w, glm::cross(d, e1)) / divisor, 0.f, 1.f);
+    if (b1 + b2 > 1.f) {
+      float sum = b1 + b2;
+      b1 /= sum, b2 /= sum;
+    }
+    Vec3 bary(1.f - b1 - b2, b1, b2);
+    return ShapeSample{mesh_->position(index_, bary), mesh_->geometric_normal(index_, bary), mesh_->uv_at(index_, bary),
+                       1.f / omega};
+  }
   ShapeSample s = sample_area(u);
   s.pdf = area_to_solid_angle_pdf(s.pdf, ctx.p, s.p, s.n);
   if (!(s.pdf > 0.f) || std::isinf(s.pdf)) return std::nullopt;
@@ -53,6 +118,11 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
 
 float Triangle::pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
                                 const Vec3& n_hit) const {
+  const uint32_t* v = &mesh_->indices[3 * index_];
+  Vec3 a = glm::normalize(mesh_->P[v[0]] - ctx.p), b = glm::normalize(mesh_->P[v[1]] - ctx.p),
+       c = glm::normalize(mesh_->P[v[2]] - ctx.p);
+  float omega = solid_angle(a, b, c);
+  if (omega >= kMinSphericalSolidAngle && omega <= kMaxSphericalSolidAngle) return 1.f / omega;
   float pdf = area_to_solid_angle_pdf(1.f / area(), ctx.p, p_hit, n_hit);
   return std::isinf(pdf) ? 0.f : pdf;
 }
