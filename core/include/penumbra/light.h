@@ -33,6 +33,16 @@ struct LightLiSample {
   Vec3 n_light{0.f};  // its normal (zero for points not on a surface)
 };
 
+/// A ray leaving a light, for methods that trace paths from the lights (light tracing, bidirectional
+/// path tracing, photon mapping).
+struct LightLeSample {
+  Ray ray;             // origin on the light (or on a disk covering the scene for infinite/distant lights)
+  Vec3 n{0.f};         // surface normal at the origin (zero for points and infinite/distant lights)
+  Rgb L{0.f};          // emitted radiance (intensity for point lights) along the ray
+  float pdf_pos = 0.f; // per unit area of the origin (1 for point lights)
+  float pdf_dir = 0.f; // per unit solid angle of the direction (1 for distant lights)
+};
+
 class Light : public Object {
  public:
   ~Light() override;
@@ -44,6 +54,12 @@ class Light : public Object {
   /// Solid-angle density of sample_li() choosing the point `hit` seen from ctx in direction wi.
   virtual float pdf_li(const LightSampleContext& ctx, const Vec3& wi,
                        const SurfaceInteraction& hit) const = 0;
+  /// Samples an emitted ray: u_pos chooses the origin, u_dir the direction. The power of the light is
+  /// E[L |cos| / (pdf_pos pdf_dir)] (tested for every light).
+  virtual std::optional<LightLeSample> sample_le(Vec2 u_pos, Vec2 u_dir) const = 0;
+  /// Densities with which sample_le() produces `ray` (with surface normal n at its origin, if any).
+  virtual void pdf_le(const Ray& ray, const Vec3& n, float* pdf_pos, float* pdf_dir) const = 0;
+
   /// Area lights: radiance leaving surface point (p, n, uv) in direction w.
   virtual Rgb L(const Vec3& p, const Vec3& n, const Vec2& uv, const Vec3& w) const;
   /// Infinite lights: radiance arriving along a ray that escapes the scene.

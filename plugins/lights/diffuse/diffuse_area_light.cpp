@@ -8,6 +8,7 @@
 // | bool twosided | false   | emit from both sides of the surface          |
 #include <penumbra/light.h>
 #include <penumbra/plugin.h>
+#include <penumbra/sampling.h>
 
 namespace {
 
@@ -38,6 +39,28 @@ class DiffuseAreaLight final : public Light {
 
   float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const SurfaceInteraction& hit) const override {
     return shape_->pdf_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, wi, hit.p, hit.ng);
+  }
+
+  // Emitted rays: a point uniform in area, a cosine-distributed direction on the emitting side (a
+  // side chosen with probability 1/2 each when two-sided).
+  std::optional<LightLeSample> sample_le(Vec2 u_pos, Vec2 u_dir) const override {
+    ShapeSample ss = shape_->sample_area(u_pos);
+    float side = 1.f;
+    if (twosided_) {
+      side = u_dir.x < 0.5f ? 1.f : -1.f;
+      u_dir.x = std::min(u_dir.x < 0.5f ? 2.f * u_dir.x : 2.f * u_dir.x - 1.f, OneMinusEpsilon);
+    }
+    Vec3 w_local = sample_cosine_hemisphere(u_dir);
+    float pdf_dir = cosine_hemisphere_pdf(w_local.z) * (twosided_ ? 0.5f : 1.f);
+    if (!(pdf_dir > 0.f)) return std::nullopt;
+    Vec3 w = Frame(ss.n).to_world(Vec3(w_local.x, w_local.y, side * w_local.z));
+    return LightLeSample{spawn_ray(ss.p, ss.n, w), ss.n, L(ss.p, ss.n, ss.uv, w), ss.pdf, pdf_dir};
+  }
+
+  void pdf_le(const Ray& ray, const Vec3& n, float* pdf_pos, float* pdf_dir) const override {
+    float c = glm::dot(n, glm::normalize(ray.d));
+    *pdf_pos = 1.f / shape_->area();
+    *pdf_dir = twosided_ ? 0.5f * std::abs(c) * InvPi : std::max(c, 0.f) * InvPi;
   }
 
  private:

@@ -84,6 +84,23 @@ class InfiniteLight final : public Light {
     return distribution_.pdf(direction_to_uv(w)) / (2.f * Pi * Pi * sin_theta);
   }
 
+  // A direction as sample_li() draws it, and an origin on a disk of the scene's radius perpendicular
+  // to it, outside the scene's bounding sphere.
+  std::optional<LightLeSample> sample_le(Vec2 u_pos, Vec2 u_dir) const override {
+    auto s = sample_li(LightSampleContext{center_}, u_dir);
+    if (!s) return std::nullopt;
+    Vec2 d = sample_uniform_disk_concentric(u_pos);
+    Frame f(s->wi);
+    Vec3 origin = center_ + radius_ * (s->wi + d.x * f.s + d.y * f.t);
+    return LightLeSample{Ray{origin, -s->wi}, Vec3(0.f), s->L, 1.f / (Pi * radius_ * radius_), s->pdf};
+  }
+
+  void pdf_le(const Ray& ray, const Vec3&, float* pdf_pos, float* pdf_dir) const override {
+    SurfaceInteraction none;
+    *pdf_pos = 1.f / (Pi * radius_ * radius_);
+    *pdf_dir = pdf_li(LightSampleContext{center_}, -glm::normalize(ray.d), none);
+  }
+
   std::vector<std::string> structures_built() const override {
     if (has_image()) return {"environment_distribution"};
     return {};

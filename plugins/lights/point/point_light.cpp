@@ -7,6 +7,7 @@
 // | point3 from  | 0 0 0   | position (before the current transform)   |
 #include <penumbra/light.h>
 #include <penumbra/plugin.h>
+#include <penumbra/sampling.h>
 
 namespace {
 
@@ -24,6 +25,13 @@ class PointLight final : public Light {
     return LightLiSample{I_ / dist2, d / std::sqrt(dist2), 1.f, p_, Vec3(0.f)};
   }
   float pdf_li(const LightSampleContext&, const Vec3&, const SurfaceInteraction&) const override { return 0.f; }
+  std::optional<LightLeSample> sample_le(Vec2, Vec2 u_dir) const override {
+    return LightLeSample{Ray{p_, sample_uniform_sphere(u_dir)}, Vec3(0.f), I_, 1.f, uniform_sphere_pdf()};
+  }
+  void pdf_le(const Ray&, const Vec3&, float* pdf_pos, float* pdf_dir) const override {
+    *pdf_pos = 0.f;  // a delta in position: no ray hits it
+    *pdf_dir = uniform_sphere_pdf();
+  }
 
  private:
   Vec3 p_;

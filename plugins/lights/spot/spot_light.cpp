@@ -11,6 +11,7 @@
 // | float conedelta  | 5       | width of the falloff band, in degrees      |
 #include <penumbra/light.h>
 #include <penumbra/plugin.h>
+#include <penumbra/sampling.h>
 
 namespace {
 
@@ -38,6 +39,16 @@ class SpotLight final : public Light {
     return LightLiSample{I_ * falloff / dist2, wi, 1.f, p_, Vec3(0.f)};
   }
   float pdf_li(const LightSampleContext&, const Vec3&, const SurfaceInteraction&) const override { return 0.f; }
+  // Directions uniform within the whole cone (falloff band included); the falloff weights L.
+  std::optional<LightLeSample> sample_le(Vec2, Vec2 u_dir) const override {
+    Vec3 w = Frame(axis_).to_world(sample_uniform_cone(u_dir, cos_end_));
+    Rgb L = I_ * smooth_step(glm::dot(w, axis_), cos_end_, cos_start_);
+    return LightLeSample{Ray{p_, w}, Vec3(0.f), L, 1.f, uniform_cone_pdf(cos_end_)};
+  }
+  void pdf_le(const Ray& ray, const Vec3&, float* pdf_pos, float* pdf_dir) const override {
+    *pdf_pos = 0.f;
+    *pdf_dir = glm::dot(glm::normalize(ray.d), axis_) >= cos_end_ ? uniform_cone_pdf(cos_end_) : 0.f;
+  }
 
  private:
   Vec3 p_, axis_;
