@@ -1,0 +1,133 @@
+// Material "conductor": metal reflection, a Trowbridge-Reitz (GGX) microfacet BRDF with the exact
+// Fresnel equations of a complex index of refraction, f = D G F / (4 |cos_o cos_i|), sampled from
+// the visible normals. Below alpha 1e-3 it is a perfect mirror (a delta lobe). Two-sided.
+//
+// | parameter          | default                    | meaning                                        |
+// |--------------------|----------------------------|------------------------------------------------|
+// | rgb eta            | 0.200438 0.924033 1.102212 | real part of the IOR per channel (copper)      |
+// | rgb k              | 3.912949 2.452848 2.142188 | imaginary part (absorption) per channel        |
+// | rgb reflectance    | (none)                     | if given, replaces eta/k: eta 1, k from R      |
+// | float roughness    | 0                          | isotropic roughness                            |
+// | float uroughness   | roughness                  | roughness along the shading frame's s axis     |
+// | float vroughness   | roughness                  | roughness along the shading frame's t axis     |
+// | bool remaproughness| true                       | alpha = sqrt(roughness) (else alpha = roughness)|
+//
+// pbrt-v4's defaults are the measured copper spectra "metal-Cu-eta"/"metal-Cu-k"; without spectral
+// rendering we use their RGB reduction (the values pbrt-v4's own exporter writes, e.g. veach-mis).
+// "rgb reflectance" is pbrt-v4's artist-friendly mode: eta = 1 and k = 2 sqrt(R) / sqrt(1 - R),
+// which makes the reflectance at normal incidence exactly R.
+#include <penumbra/bsdf.h>
+#include <penumbra/microfacet.h>
+#include <penumbra/plugin.h>
+
+namespace {
+
+using namespace penumbra;
+
+class ConductorBsdf final : public Bsdf {
+ public:
+  ConductorBsdf(TrowbridgeReitz distrib, Rgb eta, Rgb k) : distrib_(distrib), eta_(eta), k_(k) {}
+
+  uint32_t flags() const override {
+    return BsdfReflection | (distrib_.effectively_smooth() ? BsdfSpecular : BsdfGlossy);
+  }
+
+  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
+    if (!same_hemisphere(wo, wi) || distrib_.effectively_smooth()) return Rgb(0.f);
+    float cos_o = abs_cos_theta(wo), cos_i = abs_cos_theta(wi);
+    if (cos_o == 0.f || cos_i == 0.f) return Rgb(0.f);
+    std::optional<Vec3> wm = half_vector(wo, wi);
+    if (!wm) return Rgb(0.f);
+    Rgb F = fresnel_complex(std::abs(glm::dot(wo, *wm)), eta_, k_);
+    return distrib_.D(*wm) * distrib_.G(wo, wi) * F / (4.f * cos_o * cos_i);
+  }
+
+  std::optional<BsdfSample> sample_f(const Vec3& wo, float, Vec2 u, const ShadingContext& ctx) const override {
+    if (wo.z == 0.f) return std::nullopt;
+    if (distrib_.effectively_smooth()) {
+      // Delta reflection: the weight f |cos| / pdf must be F, so f carries F / |cos|.
+      Vec3 wi(-wo.x, -wo.y, wo.z);
+      float cos_i = abs_cos_theta(wi);
+      return BsdfSample{fresnel_complex(cos_i, eta_, k_) / cos_i, wi, 1.f, BsdfReflection | BsdfSpecular};
+    }
+    Vec3 wm = distrib_.sample_wm(wo, u);
+    Vec3 wi = reflect(wo, wm);
+    if (!same_hemisphere(wo, wi)) return std::nullopt;  // reflected into the microsurface
+    float pdf = distrib_.pdf(wo, wm) / (4.f * std::abs(glm::dot(wo, wm)));
+    if (!(pdf > 0.f) || wi.z == 0.f) return std::nullopt;
+    return BsdfSample{f(wo, wi, ctx), wi, pdf, BsdfReflection | BsdfGlossy};
+  }
+
+  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
+    if (!same_hemisphere(wo, wi) || distrib_.effectively_smooth()) return 0.f;
+    std::optional<Vec3> wm = half_vector(wo, wi);
+    if (!wm) return 0.f;
+    // Reflection maps half vectors to directions with Jacobian 1 / (4 |wo . wm|).
+    return distrib_.pdf(wo, *wm) / (4.f * std::abs(glm::dot(wo, *wm)));
+  }
+
+  LobeSummary lobe(const Vec3& wo, const ShadingContext&) const override {
+    LobeSummary l;
+    l.peak = Vec3(-wo.x, -wo.y, wo.z);
+    l.alpha_x = distrib_.alpha_x();
+    l.alpha_y = distrib_.alpha_y();
+    l.coefficient = luminance(fresnel_complex(1.f, eta_, k_));
+    return l;
+  }
+
+ private:
+  // Half vector of a reflection pair, on the +z side (the distribution's domain).
+  static std::optional<Vec3> half_vector(const Vec3& wo, const Vec3& wi) {
+    Vec3 wm = wo + wi;
+    if (glm::dot(wm, wm) == 0.f) return std::nullopt;
+    wm = glm::normalize(wm);
+    return wm.z < 0.f ? -wm : wm;
+  }
+
+  TrowbridgeReitz distrib_;
+  Rgb eta_, k_;
+};
+
+const ParamSpec kParams[] = {
+    {"rgb", "eta", "0.200438 0.924033 1.102212", "real part of the IOR per channel (default: copper)"},
+    {"rgb", "k", "3.912949 2.452848 2.142188", "absorption coefficient per channel (default: copper)"},
+    {"rgb", "reflectance", "", "reflectance at normal incidence; replaces eta and k (eta = 1)"},
+    {"float", "roughness", "0", "isotropic microfacet roughness (0: perfect mirror)"},
+    {"float", "uroughness", "", "roughness along the shading frame's s axis (default: roughness)"},
+    {"float", "vroughness", "", "roughness along the shading frame's t axis (default: roughness)"},
+    {"bool", "remaproughness", "true", "alpha = sqrt(roughness) if true, else alpha = roughness"},
+    {"unsupported", "displacement", "", "displacement is not supported"},
+    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
+};
+
+Object* create(const CreateContext& ctx) {
+  const ParamSet& p = ctx.params;
+  float roughness = p.get_float("roughness");
+  float ur = p.get_float("uroughness", roughness), vr = p.get_float("vroughness", roughness);
+  for (const char* name : {"roughness", "uroughness", "vroughness"})
+    if (p.has(name) && !(p.get_float(name) >= 0.f)) throw Error(p.loc_of(name), std::string(name) + " must be >= 0");
+  if (p.get_bool("remaproughness")) {
+    ur = TrowbridgeReitz::roughness_to_alpha(ur);
+    vr = TrowbridgeReitz::roughness_to_alpha(vr);
+  }
+  Rgb eta = p.get_rgb("eta"), k = p.get_rgb("k");
+  if (p.has("reflectance")) {
+    if (p.has("eta") || p.has("k"))
+      throw Error(p.loc_of("reflectance"), "give either reflectance or eta and k, not both");
+    Rgb r = p.get_rgb("reflectance");
+    if (!(r.r >= 0.f && r.g >= 0.f && r.b >= 0.f && r.r <= 1.f && r.g <= 1.f && r.b <= 1.f))
+      throw Error(p.loc_of("reflectance"), "reflectance must be in [0, 1]");
+    // R = 1 would need k = infinity; 0.9999 is indistinguishable and keeps Fresnel finite.
+    r = glm::min(r, Rgb(0.9999f));
+    eta = Rgb(1.f);
+    k = 2.f * glm::sqrt(r) / glm::sqrt(Rgb(1.f) - r);
+  }
+  if (!(eta.r > 0.f && eta.g > 0.f && eta.b > 0.f))
+    throw Error(p.loc_of("eta"), "eta must be > 0 in every channel");
+  if (!(k.r >= 0.f && k.g >= 0.f && k.b >= 0.f)) throw Error(p.loc_of("k"), "k must be >= 0 in every channel");
+  return new ConductorBsdf(TrowbridgeReitz(ur, vr), eta, k);
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Bsdf, "conductor", "metal: rough or smooth GGX reflection with complex Fresnel", kParams, create)
