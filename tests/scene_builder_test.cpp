@@ -67,15 +67,16 @@ TEST(SceneBuilder, BuildsNoLightDistributionWithoutLights) {
   EXPECT_EQ(registry.loaded(), (std::vector<std::string>{"sampler/independent", "integrator/path", "bsdf/diffuse"}));
 }
 
-TEST(SceneBuilder, MaterialErrorInRealSceneIsLocated) {
-  SceneDescription d = parse_scene_file(scene_path("veach-bidir"));
+TEST(SceneBuilder, UnknownMaterialIsLocatedAndListsAvailable) {
+  SceneDescription d = parse_scene_string(
+      "Camera \"perspective\"\nWorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"coatedconductor\"\nNamedMaterial \"m\"\nShape \"sphere\"\n",
+      "s.pbrt");
   Registry registry = builtin_registry();
-  d.integrator.type = "path";
-  d.integrator.params = ParamSet{};
   try {
     build_scene(d, registry);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_THAT(e.formatted(), ::testing::HasSubstr("veach-bidir/scene-v4.pbrt:22:1: error: unknown bsdf 'dielectric'"));
+    EXPECT_THAT(e.formatted(), ::testing::HasSubstr("s.pbrt:3:1: error: unknown bsdf 'coatedconductor'; available: "));
+    EXPECT_THAT(e.formatted(), ::testing::HasSubstr("conductor"));
   }
 }
