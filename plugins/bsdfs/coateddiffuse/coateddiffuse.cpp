@@ -1,0 +1,75 @@
+// Material "coateddiffuse" (pbrt-v4): a diffuse base under a dielectric coat. pbrt-v4 simulates the
+// layers stochastically; Penumbra approximates them with the Disney BSDF's pieces, and says so when
+// a scene uses it: Burley's diffuse with the base reflectance (its (1 - F/2) factors darken grazing
+// angles as a coat does) plus the GTR1 clearcoat at full strength, with R0 from the coat's eta and
+// its gloss from the coat's roughness. The Disney specular lobe is off (eta 1), so the coat is the
+// only specular reflection. Not energy-exact: the diffuse is not dimmed by what the coat reflects.
+//
+// | parameter            | default     | meaning                                                   |
+// |----------------------|-------------|-----------------------------------------------------------|
+// | rgb reflectance      | 0.5 0.5 0.5 | diffuse base albedo, each channel in [0, 1]               |
+// | float roughness      | 0           | coat roughness (both directions)                          |
+// | float uroughness     | roughness   | coat roughness along s (averaged with v: coat is isotropic) |
+// | float vroughness     | roughness   | coat roughness along t                                    |
+// | bool remaproughness  | true        | alpha = sqrt(roughness) as in pbrt-v4, else alpha = roughness |
+// | float thickness      | 0.01        | accepted and ignored (no absorption in the layer)         |
+// | float eta            | 1.5         | coat IOR, sets its normal-incidence reflectance           |
+//
+// Coat alpha maps to GTR1's: alpha 0 -> 0.001 (clearcoatgloss 1), alpha >= 0.1 -> 0.1 (gloss 0).
+#include "../disney/disney_bsdf.h"
+
+#include <penumbra/plugin.h>
+
+namespace {
+
+using namespace penumbra;
+
+const ParamSpec kParams[] = {
+    {"rgb", "reflectance", "0.5 0.5 0.5", "diffuse base albedo, each channel in [0, 1]"},
+    {"float", "roughness", "0", "coat roughness"},
+    {"float", "uroughness", "", "coat roughness along s (default: roughness)"},
+    {"float", "vroughness", "", "coat roughness along t (default: roughness)"},
+    {"bool", "remaproughness", "true", "alpha = sqrt(roughness) when true, alpha = roughness otherwise"},
+    {"float", "thickness", "0.01", "coat thickness: accepted and ignored (no absorption modelled)"},
+    {"float", "eta", "1.5", "coat index of refraction"},
+    {"unsupported", "albedo", "", "a scattering coat layer is not supported"},
+    {"unsupported", "g", "", "a scattering coat layer is not supported"},
+    {"unsupported", "maxdepth", "", "the layers are approximated, not random-walked"},
+    {"unsupported", "nsamples", "", "the layers are approximated, not random-walked"},
+    {"unsupported", "displacement", "", "displacement is not supported"},
+    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
+};
+
+Object* create(const CreateContext& ctx) {
+  const ParamSet& ps = ctx.params;
+  Rgb r = ps.get_rgb("reflectance");
+  if (!(glm::all(glm::greaterThanEqual(r, Rgb(0.f))) && glm::all(glm::lessThanEqual(r, Rgb(1.f)))))
+    throw Error(ps.loc_of("reflectance"), "reflectance must be in [0, 1] (energy would not be conserved)");
+  float eta = ps.get_float("eta");
+  if (!(eta > 0.f && std::isfinite(eta))) throw Error(ps.loc_of("eta"), "eta must be positive");
+  float roughness = ps.get_float("roughness");
+  float u = ps.has("uroughness") ? ps.get_float("uroughness") : roughness;
+  float v = ps.has("vroughness") ? ps.get_float("vroughness") : roughness;
+  if (!(u >= 0.f && v >= 0.f)) throw Error(ps.loc_of("roughness"), "roughness must be >= 0");
+  if (ps.get_bool("remaproughness")) {
+    u = TrowbridgeReitz::roughness_to_alpha(u);
+    v = TrowbridgeReitz::roughness_to_alpha(v);
+  }
+  float alpha = std::sqrt(u * v);  // GTR1 is isotropic: keep the lobe's area
+
+  warning(ctx.loc, "coateddiffuse is approximated by Disney's diffuse + clearcoat");
+  disney::DisneyParams p;
+  p.color = r;
+  p.metallic = 0.f;
+  p.eta = 1.f;          // no Disney specular lobe: the clearcoat is the coat
+  p.roughness = 0.f;    // no retro-reflection: pbrt-v4's base is Lambertian
+  p.clearcoat = 4.f;    // weight 0.25 * 4 = 1: a real coat reflects its full Fresnel
+  p.clearcoat_gloss = std::clamp((0.1f - alpha) / (0.1f - 0.001f), 0.f, 1.f);
+  p.clearcoat_r0 = disney::schlick_r0_from_eta(eta);
+  return new disney::DisneyBsdf(p);
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Bsdf, "coateddiffuse", "diffuse base under a clear coat (approximated with Disney lobes)", kParams,
+                create)
