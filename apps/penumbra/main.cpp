@@ -3,6 +3,7 @@
 //   penumbra render SCENE [opts]   renders a scene, command-line options override the file
 //   penumbra plugins               lists the plugins found and their parameters
 #include "commands.h"
+#include "converge.h"
 
 #include <penumbra/error.h>
 #include <penumbra/version.h>
@@ -47,6 +48,21 @@ int main(int argc, char** argv) {
   render->add_option("--stats", settings.stats_file, "write render statistics as JSON");
   render->add_flag("-q,--quiet", settings.quiet, "no progress output");
 
+  penumbra::cli::ConvergeSettings conv;
+  std::string conv_configs, conv_res;
+  auto* converge = app.add_subcommand("converge", "Measure error versus time of integrator:sampler configurations");
+  converge->add_option("scene", conv.scene, "pbrt-v4 scene file")->required()->check(CLI::ExistingFile);
+  converge->add_option("--configs", conv_configs, "comma-separated integrator[:sampler] list, e.g. path:sobol,bdpt:sobol")->required();
+  converge->add_option("--reference", conv.reference, "reference image (EXR); reference-variance.exr beside it is used if present")->check(CLI::ExistingFile);
+  converge->add_option("--make-reference", conv.make_reference, "render a reference for this many seconds (two halves)")->check(CLI::PositiveNumber);
+  converge->add_option("--reference-config", conv.reference_config, "integrator[:sampler] for --make-reference");
+  converge->add_option("--time", conv.time, "time budget per run, seconds")->check(CLI::PositiveNumber);
+  converge->add_option("--runs", conv.runs, "independent runs per configuration")->check(CLI::Range(1, 1000));
+  converge->add_option("--snapshots", conv.snapshots, "log-spaced snapshots per run")->check(CLI::Range(2, 64));
+  converge->add_option("-o,--output", conv.out_dir, "output folder");
+  converge->add_option("--res", conv_res, "image resolution WIDTHxHEIGHT");
+  converge->add_option("--threads", conv.threads, "worker threads")->check(CLI::Range(1, 1024));
+
   std::vector<std::string> plugin_dirs;
   auto* plugins = app.add_subcommand("plugins", "List plugins with their parameters");
   plugins->add_option("--dir", plugin_dirs, "search these folders instead of the default path");
@@ -66,6 +82,11 @@ int main(int argc, char** argv) {
 
   try {
     if (*plugins) return penumbra::cli::run_plugins(plugin_dirs);
+    if (*converge) {
+      conv.configs = penumbra::cli::parse_configs(conv_configs);
+      if (!conv_res.empty()) conv.resolution = parse_resolution(conv_res);
+      return penumbra::cli::run_converge(conv);
+    }
     if (!*render) settings.scene_file = penumbra::cli::default_scene();
     if (*spp_opt) settings.spp = spp;
     if (*seed_opt) settings.seed = seed;

@@ -6,11 +6,13 @@
 
 #include <penumbra/bsdf.h>
 #include <penumbra/film.h>
+#include <penumbra/image.h>
 #include <penumbra/object.h>
 #include <penumbra/sampler.h>
 #include <penumbra/scene.h>
 
 #include <cstdint>
+#include <functional>
 
 namespace penumbra {
 
@@ -36,8 +38,11 @@ class RenderContext {
   virtual void progress(uint64_t done, uint64_t total) = 0;
   /// Records a discarded non-finite sample at `pixel`; thread-safe.
   virtual void report_nonfinite(Point2i pixel) = 0;
-  /// Records that the render finished `spp` samples per pixel.
-  virtual void set_completed_spp(int spp) = 0;
+  /// Records that `spp` samples per pixel (or iterations) are complete; call it after every whole
+  /// pass. The runtime may then take a snapshot of the current estimate (convergence studies): from
+  /// the film, or, when the film does not hold the estimate (photon mapping), from `estimate`, which
+  /// it calls only for a snapshot. Time spent in snapshots is excluded from elapsed().
+  virtual void set_completed_spp(int spp, const std::function<ImageRgb()>& estimate = {}) = 0;
 };
 
 class Integrator : public Object {

@@ -40,14 +40,14 @@ uint64_t peak_memory_bytes() {
 
 class Session final : public RenderContext {
  public:
-  Session(BuiltScene& built, RenderOptions options, bool quiet)
-      : built_(built), options_(options), progress_("samples", quiet) {}
+  Session(BuiltScene& built, RenderOptions options, const RenderSettings& settings)
+      : built_(built), options_(options), settings_(settings), progress_("samples", settings.quiet) {}
 
   const Scene& scene() const override { return *built_.scene; }
   Film& film() override { return *built_.film; }
   const Sampler& sampler() const override { return *built_.sampler; }
   const RenderOptions& options() const override { return options_; }
-  double elapsed() const override { return seconds_since(start_); }
+  double elapsed() const override { return seconds_since(start_) - snapshot_seconds_; }
   void progress(uint64_t done, uint64_t total) override {
     progress_.update(done, total, elapsed(), options_.time_budget);
   }
@@ -57,7 +57,17 @@ class Session final : public RenderContext {
       first_nonfinite_ = {pixel.x, pixel.y};
     }
   }
-  void set_completed_spp(int spp) override { completed_spp_ = spp; }
+  void set_completed_spp(int spp, const std::function<ImageRgb()>& estimate) override {
+    completed_spp_ = spp;
+    if (!settings_.on_snapshot || next_snapshot_ >= settings_.snapshot_times.size()) return;
+    double t = elapsed();
+    if (t < settings_.snapshot_times[next_snapshot_]) return;
+    while (next_snapshot_ < settings_.snapshot_times.size() && settings_.snapshot_times[next_snapshot_] <= t)
+      ++next_snapshot_;
+    auto t0 = Clock::now();
+    settings_.on_snapshot(t, spp, estimate ? estimate() : built_.film->image(spp));
+    snapshot_seconds_ += seconds_since(t0);
+  }
 
   void start() { start_ = Clock::now(); }
   void finish() { progress_.finish(elapsed()); }
@@ -68,6 +78,9 @@ class Session final : public RenderContext {
  private:
   BuiltScene& built_;
   RenderOptions options_;
+  const RenderSettings& settings_;
+  size_t next_snapshot_ = 0;
+  double snapshot_seconds_ = 0.0;
   ProgressReporter progress_;
   Clock::time_point start_ = Clock::now();
   std::atomic<uint64_t> nonfinite_{0};
@@ -130,7 +143,7 @@ RenderResult render(const RenderSettings& settings) {
   if (options.spp <= 0) throw Error(desc.sampler.params.loc_of("pixelsamples"), "pixelsamples must be positive");
   double load_seconds = seconds_since(t0);
 
-  Session session(built, options, settings.quiet);
+  Session session(built, options, settings);
   session.start();
   built.integrator->render(session);
   double seconds = session.elapsed();

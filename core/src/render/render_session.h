@@ -5,6 +5,7 @@
 #include "image/image_io.h"
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,11 @@ struct RenderSettings {
   std::string stats_file;                // --stats FILE.json
   bool quiet = false;                    // no progress output
   std::vector<std::string> plugin_dirs;  // default: Registry::default_search_dirs()
+  /// Snapshots for convergence studies: after the first complete pass at or past each of these
+  /// render times (seconds, ascending), `on_snapshot` receives the current estimate. The time spent
+  /// in the callback does not count as render time.
+  std::vector<double> snapshot_times;
+  std::function<void(double seconds, int spp, const ImageRgb& image)> on_snapshot;
 };
 
 struct RenderStats {

@@ -1,0 +1,188 @@
+#include "converge.h"
+
+#include "image/image_io.h"
+#include "render/image_metrics.h"
+#include "render/render_session.h"
+
+#include <penumbra/error.h>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+namespace fs = std::filesystem;
+
+namespace penumbra::cli {
+
+namespace {
+
+struct Row {
+  std::string config;
+  int run = 0, snapshot = 0;
+  double seconds = 0;
+  int spp = 0;
+  ImageErrors errors;
+};
+
+std::string config_name(const std::pair<std::string, std::string>& c) {
+  return c.second.empty() ? c.first : c.first + ":" + c.second;
+}
+
+RenderSettings base_settings(const ConvergeSettings& s, const std::pair<std::string, std::string>& config, uint32_t seed) {
+  RenderSettings r;
+  r.scene_file = s.scene;
+  r.integrator = config.first;
+  r.sampler = config.second;
+  r.seed = seed;
+  r.resolution = s.resolution;
+  r.threads = s.threads;
+  r.quiet = true;
+  return r;
+}
+
+// Two independent half-length renders: their mean is the reference, and their difference estimates
+// the reference's own variance, which is subtracted from every measured squared error.
+void make_reference(const ConvergeSettings& s, ImageRgb* reference, ImageRgb* variance) {
+  auto config = parse_configs(s.reference_config).at(0);
+  ImageRgb halves[2];
+  for (int h = 0; h < 2; ++h) {
+    RenderSettings r = base_settings(s, config, 1000001u + h);
+    r.time_budget = s.make_reference / 2.0;
+    std::fprintf(stderr, "converge: reference half %d (%s, %.0f s)\n", h + 1, s.reference_config.c_str(), r.time_budget);
+    halves[h] = render(r).image;
+  }
+  *variance = half_reference_variance(halves[0], halves[1], reference);
+  write_image((fs::path(s.out_dir) / "reference.exr").string(), *reference);
+  write_image((fs::path(s.out_dir) / "reference-variance.exr").string(), *variance);
+}
+
+// Time at which a mean error curve first reaches `target`, interpolated in log-log; -1 if never.
+double time_to_reach(const std::vector<std::pair<double, double>>& curve, double target) {
+  for (size_t i = 0; i < curve.size(); ++i) {
+    if (curve[i].second > target) continue;
+    if (i == 0) return curve[0].first;
+    auto [t0, e0] = curve[i - 1];
+    auto [t1, e1] = curve[i];
+    double f = (std::log(target) - std::log(e0)) / (std::log(e1) - std::log(e0));
+    return std::exp(std::log(t0) + f * (std::log(t1) - std::log(t0)));
+  }
+  return -1.0;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> parse_configs(const std::string& text) {
+  std::vector<std::pair<std::string, std::string>> out;
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t end = text.find(',', start);
+    if (end == std::string::npos) end = text.size();
+    std::string item = text.substr(start, end - start);
+    if (!item.empty()) {
+      size_t colon = item.find(':');
+      out.emplace_back(item.substr(0, colon), colon == std::string::npos ? "" : item.substr(colon + 1));
+      if (out.back().first.empty()) throw Error(fmt::format("--configs: '{}' names no integrator", item));
+    }
+    start = end + 1;
+  }
+  if (out.empty()) throw Error("--configs: give at least one integrator[:sampler]");
+  return out;
+}
+
+int run_converge(const ConvergeSettings& s) {
+  if (s.configs.empty()) throw Error("--configs: give at least one integrator[:sampler]");
+  if (s.runs < 1) throw Error("--runs must be at least 1");
+  if (s.snapshots < 2) throw Error("--snapshots must be at least 2");
+  fs::create_directories(s.out_dir);
+
+  ImageRgb reference, variance;
+  bool have_variance = false;
+  if (s.make_reference > 0.0) {
+    make_reference(s, &reference, &variance);
+    have_variance = true;
+  } else if (!s.reference.empty()) {
+    reference = read_image(s.reference);
+    fs::path var_path = fs::path(s.reference).parent_path() / "reference-variance.exr";
+    if (fs::exists(var_path)) {
+      variance = read_image(var_path.string());
+      have_variance = true;
+    }
+  } else {
+    throw Error("give --reference REF.exr or --make-reference SECONDS");
+  }
+
+  std::vector<double> times;
+  for (int k = 0; k < s.snapshots; ++k) times.push_back(s.time * std::pow(2.0, -(s.snapshots - 1 - k)));
+
+  std::vector<Row> rows;
+  for (const auto& config : s.configs) {
+    for (int run = 0; run < s.runs; ++run) {
+      RenderSettings r = base_settings(s, config, static_cast<uint32_t>(run + 1));
+      r.time_budget = s.time;
+      r.snapshot_times = times;
+      int snapshot = 0;
+      r.on_snapshot = [&](double seconds, int spp, const ImageRgb& img) {
+        ImageErrors e = image_errors(img, reference, have_variance ? &variance : nullptr);
+        rows.push_back(Row{config_name(config), run, snapshot++, seconds, spp, e});
+      };
+      std::fprintf(stderr, "converge: %s run %d/%d (%.0f s)\n", config_name(config).c_str(), run + 1, s.runs, s.time);
+      render(r);
+    }
+  }
+
+  // Raw rows.
+  std::ofstream csv(fs::path(s.out_dir) / "results.csv");
+  csv << "config,run,snapshot,seconds,spp,rmse,relmse,mae\n";
+  for (const Row& row : rows)
+    csv << fmt::format("{},{},{},{:.6g},{},{:.6g},{:.6g},{:.6g}\n", row.config, row.run, row.snapshot, row.seconds,
+                       row.spp, row.errors.rmse, row.errors.rel_mse, row.errors.mae);
+
+  // Mean and spread per configuration and snapshot; time to reach a common relMSE; efficiency.
+  nlohmann::json summary;
+  summary["scene"] = s.scene;
+  summary["relmse_epsilon"] = kRelMseEpsilon;
+  summary["relmse_formula"] = "mean over pixels and channels of (I - R)^2 / (R^2 + eps), reference variance subtracted";
+  summary["reference_variance_subtracted"] = have_variance;
+  summary["time_budget"] = s.time;
+  summary["runs"] = s.runs;
+  std::map<std::string, std::vector<std::pair<double, double>>> curves;
+  double common_target = 0.0;
+  for (const auto& config : s.configs) {
+    std::string name = config_name(config);
+    nlohmann::json points = nlohmann::json::array();
+    for (int k = 0; k < s.snapshots; ++k) {
+      double t = 0, spp = 0, rmse = 0, rel = 0, mae = 0, rel_min = 1e300, rel_max = -1e300;
+      int n = 0;
+      for (const Row& row : rows)
+        if (row.config == name && row.snapshot == k) {
+          t += row.seconds, spp += row.spp, rmse += row.errors.rmse, rel += row.errors.rel_mse, mae += row.errors.mae;
+          rel_min = std::min(rel_min, row.errors.rel_mse), rel_max = std::max(rel_max, row.errors.rel_mse);
+          ++n;
+        }
+      if (n == 0) continue;
+      points.push_back({{"seconds", t / n}, {"spp", spp / n}, {"rmse", rmse / n}, {"relmse", rel / n},
+                        {"relmse_min", rel_min}, {"relmse_max", rel_max}, {"mae", mae / n}, {"runs", n}});
+      curves[name].emplace_back(t / n, rel / n);
+    }
+    summary["configs"][name]["points"] = points;
+    if (!curves[name].empty()) {
+      auto [t_final, rel_final] = curves[name].back();
+      summary["configs"][name]["final_relmse"] = rel_final;
+      summary["configs"][name]["efficiency"] = rel_final > 0 ? 1.0 / (rel_final * t_final) : 0.0;
+      common_target = std::max(common_target, rel_final);
+    }
+  }
+  // The target every configuration reaches: the worst final relMSE.
+  summary["time_to_reach"]["relmse"] = common_target;
+  for (const auto& [name, curve] : curves) summary["time_to_reach"]["seconds"][name] = time_to_reach(curve, common_target);
+  std::ofstream(fs::path(s.out_dir) / "summary.json") << summary.dump(2) << "\n";
+  std::fprintf(stderr, "converge: wrote %s/results.csv and summary.json (%zu snapshots)\n", s.out_dir.c_str(), rows.size());
+  return 0;
+}
+
+}  // namespace penumbra::cli

@@ -1,0 +1,48 @@
+#include "render/image_metrics.h"
+
+#include <penumbra/error.h>
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+namespace penumbra {
+
+static void check_same_size(const ImageRgb& a, const ImageRgb& b) {
+  if (a.width != b.width || a.height != b.height || a.pixels.size() != b.pixels.size())
+    throw Error(fmt::format("images differ in size: {}x{} and {}x{}", a.width, a.height, b.width, b.height));
+}
+
+ImageErrors image_errors(const ImageRgb& image, const ImageRgb& reference, const ImageRgb* reference_variance) {
+  check_same_size(image, reference);
+  if (reference_variance) check_same_size(image, *reference_variance);
+  double se = 0, rel = 0, ae = 0;
+  size_t n = image.pixels.size();
+  for (size_t i = 0; i < n; ++i) {
+    double r = reference.pixels[i], d = image.pixels[i] - r;
+    double d2 = d * d - (reference_variance ? reference_variance->pixels[i] : 0.0);
+    se += d2;
+    rel += d2 / (r * r + kRelMseEpsilon);
+    ae += std::abs(d);
+  }
+  ImageErrors e;
+  e.mse = n ? se / n : 0.0;
+  e.rmse = std::sqrt(std::max(0.0, e.mse));
+  e.rel_mse = n ? rel / n : 0.0;
+  e.mae = n ? ae / n : 0.0;
+  return e;
+}
+
+ImageRgb half_reference_variance(const ImageRgb& a, const ImageRgb& b, ImageRgb* mean) {
+  check_same_size(a, b);
+  ImageRgb var = a;
+  if (mean) *mean = a;
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    double d = a.pixels[i] - b.pixels[i];
+    var.pixels[i] = static_cast<float>(d * d / 4.0);
+    if (mean) mean->pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
+  }
+  return var;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Regenerates docs/convergence.md and its plots: for each bundled scene, `penumbra converge` renders
+# every available integrator:sampler configuration progressively against a fresh reference, then
+# scripts/plot-convergence.py draws relMSE versus time and scripts/write-convergence-doc.py writes
+# the tables. Settings (environment variables): TIME seconds per run, RUNS runs per configuration,
+# REF seconds for the reference, RES resolution, SNAPSHOTS per run, SCENES to limit the scenes.
+# The defaults take about an hour on 2 cores; TIME=6 RUNS=2 REF=40 gives a quick look.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+TIME=${TIME:-20}
+RUNS=${RUNS:-3}
+REF=${REF:-240}
+RES=${RES:-128x96}
+SNAPSHOTS=${SNAPSHOTS:-7}
+scripts/build.sh >&2
+bin=build/bin/penumbra
+plugins=$($bin plugins 2>/dev/null || true)
+has() { grep -q "$1 '$2'" <<<"$plugins"; }
+
+# name | scene file | configurations (only those whose plugins exist are run) | reference configuration
+studies=(
+  "cornell-box|scenes/cornell-box/scene.pbrt|path:independent path:sobol path:halton bdpt:sobol sppm:halton|path:sobol"
+  "environment|scenes/environment/scene.pbrt|path:independent path:sobol bdpt:sobol sppm:halton|path:sobol"
+  "caustics|scenes/caustics/scene.pbrt|path:sobol bdpt:sobol sppm:halton|bdpt:sobol"
+  "sppm-caustics|scenes/sppm-caustics/scene.pbrt|path:sobol bdpt:sobol sppm:halton|sppm:halton"
+)
+out=docs/convergence
+mkdir -p "$out"
+for study in "${studies[@]}"; do
+  IFS='|' read -r name scene configs refconfig <<<"$study"
+  if [ -n "${SCENES:-}" ] && ! grep -qw "$name" <<<"$SCENES"; then continue; fi
+  [ -f "$scene" ] || { echo "skipping $name: $scene does not exist yet" >&2; continue; }
+  list=()
+  for c in $configs; do has integrator "${c%%:*}" && list+=("$c"); done
+  has integrator "${refconfig%%:*}" || refconfig="path:sobol"
+  joined=$(IFS=,; echo "${list[*]}")
+  echo "== $name: $joined (reference $refconfig, ${REF}s)" >&2
+  $bin converge "$scene" --configs "$joined" --make-reference "$REF" --reference-config "$refconfig" \
+    --time "$TIME" --runs "$RUNS" --snapshots "$SNAPSHOTS" --res "$RES" -o "$out/$name"
+  /usr/bin/python3 scripts/plot-convergence.py "$out/$name" "$name"
+  rm -f "$out/$name"/reference*.exr
+done
+/usr/bin/python3 scripts/write-convergence-doc.py "$out" "TIME=$TIME RUNS=$RUNS REF=$REF RES=$RES SNAPSHOTS=$SNAPSHOTS" > docs/convergence.md
+echo "wrote docs/convergence.md" >&2
