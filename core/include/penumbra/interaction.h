@@ -1,13 +1,13 @@
-// Rays and surface hits, with robust spawning of secondary rays: origins are pushed off the surface
-// along the geometric normal by a few ULPs (Waechter and Binder, Ray Tracing Gems ch. 6), so a new
-// ray neither re-hits its own surface nor leaks through thin geometry, whatever the distance from the
-// origin.
+// Rays and surface hits, with robust spawning of secondary rays. Every hit point carries a
+// conservative bound on its floating-point error (pbrt's approach); a new ray starts just outside
+// that error box along the geometric normal, rounded away from the surface, so it neither re-hits
+// its own surface nor starts far from it, at any distance from the origin or any scene scale.
 #pragma once
 
 #include <penumbra/color.h>
 #include <penumbra/math.h>
 
-#include <cstring>
+#include <cmath>
 
 namespace penumbra {
 
@@ -20,21 +20,33 @@ struct Ray {
   float tmax = Infinity;
 };
 
-/// Moves `p` off a surface with geometric normal `n` towards the side `w` points to.
-inline Vec3 offset_ray_origin(const Vec3& p, Vec3 n, const Vec3& w) {
-  constexpr float origin = 1.f / 32.f, float_scale = 1.f / 65536.f, int_scale = 256.f;
-  if (glm::dot(n, w) < 0.f) n = -n;
-  Vec3 out;
+/// Bound on the relative error of a value computed by n float operations (pbrt's gamma_n).
+constexpr float error_gamma(int n) {
+  constexpr float eps = 0x1p-24f;
+  return n * eps / (1.f - n * eps);
+}
+
+/// Error bound of a point known only by its coordinates (a light sample, a point handed to the SDK):
+/// that of a barycentric interpolation of vertices of its own magnitude, plus a tiny absolute floor
+/// for points near the origin.
+inline Vec3 point_error_bound(const Vec3& p) { return error_gamma(7) * glm::abs(p) + Vec3(1e-7f); }
+
+/// Moves `p` (absolute error at most p_error per component) off a surface with geometric normal `n`
+/// towards the side `w` points to: past the error box along n, each coordinate rounded away.
+inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, Vec3 n, const Vec3& w) {
+  float d = glm::dot(glm::abs(n), p_error);
+  Vec3 offset = d * n;
+  if (glm::dot(w, n) < 0.f) offset = -offset;
+  Vec3 po = p + offset;
   for (int k = 0; k < 3; ++k) {
-    int32_t of_i = static_cast<int32_t>(int_scale * n[k]);
-    int32_t bits;
-    std::memcpy(&bits, &p[k], sizeof bits);
-    bits += (p[k] < 0.f) ? -of_i : of_i;
-    float p_i;
-    std::memcpy(&p_i, &bits, sizeof p_i);
-    out[k] = std::abs(p[k]) < origin ? p[k] + float_scale * n[k] : p_i;
+    if (offset[k] > 0.f) po[k] = std::nextafter(po[k], Infinity);
+    else if (offset[k] < 0.f) po[k] = std::nextafter(po[k], -Infinity);
   }
-  return out;
+  return po;
+}
+
+inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n, const Vec3& w) {
+  return offset_ray_origin(p, point_error_bound(p), n, w);
 }
 
 /// A ray from a surface point (p, ng) in direction d.
@@ -42,17 +54,23 @@ inline Ray spawn_ray(const Vec3& p, const Vec3& ng, const Vec3& d) {
   return Ray{offset_ray_origin(p, ng, d), d, Infinity};
 }
 
-/// A shadow ray between two surface points, both ends offset; it stops just short of the target.
-/// Pass a zero normal for a point not on a surface (point light, camera).
-inline Ray spawn_ray_to(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) {
-  Vec3 o = n0 == Vec3(0.f) ? p0 : offset_ray_origin(p0, n0, p1 - p0);
-  Vec3 target = n1 == Vec3(0.f) ? p1 : offset_ray_origin(p1, n1, o - p1);
+/// A shadow ray between two points with error bounds e0, e1, both ends offset along their normals
+/// (a zero normal for a point not on a surface: point light, camera); it stops just short of the target.
+inline Ray spawn_ray_to(const Vec3& p0, const Vec3& e0, const Vec3& n0, const Vec3& p1, const Vec3& e1,
+                        const Vec3& n1) {
+  Vec3 o = n0 == Vec3(0.f) ? p0 : offset_ray_origin(p0, e0, n0, p1 - p0);
+  Vec3 target = n1 == Vec3(0.f) ? p1 : offset_ray_origin(p1, e1, n1, o - p1);
   return Ray{o, target - o, 1.f - 1e-4f};
+}
+
+inline Ray spawn_ray_to(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) {
+  return spawn_ray_to(p0, point_error_bound(p0), n0, p1, point_error_bound(p1), n1);
 }
 
 /// Everything an integrator needs about a ray hit.
 struct SurfaceInteraction {
   Vec3 p;            // hit point, reconstructed from the primitive (not o + t d)
+  Vec3 p_error{0.f}; // bound on the absolute error of p, per component
   Vec3 ng;           // geometric normal, oriented as the shape defines its outside
   Vec3 ns;           // shading normal, in the same hemisphere as ng
   Vec2 uv;           // surface parameterisation
@@ -63,7 +81,11 @@ struct SurfaceInteraction {
   const Light* area_light = nullptr;  // emitter on this primitive, if any
   uint32_t shape_id = 0, prim_id = 0;
 
-  Ray spawn_ray(const Vec3& d) const { return penumbra::spawn_ray(p, ng, d); }
+  Ray spawn_ray(const Vec3& d) const { return Ray{offset_ray_origin(p, p_error, ng, d), d, Infinity}; }
+  /// Shadow ray to a point p1 (normal n1, zero if none) whose error is estimated from its magnitude.
+  Ray spawn_ray_to(const Vec3& p1, const Vec3& n1) const {
+    return penumbra::spawn_ray_to(p, p_error, ng, p1, point_error_bound(p1), n1);
+  }
 };
 
 }  // namespace penumbra

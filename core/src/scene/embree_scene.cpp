@@ -134,12 +134,14 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
     // The hit point comes from the barycentrics: its error does not grow with t.
     Vec3 b(1.f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v);
     si.p = g.mesh->position(rh.hit.primID, b);
+    si.p_error = g.mesh->position_error(rh.hit.primID, b);
     si.ng = g.mesh->geometric_normal(rh.hit.primID, b);
     Vec3 ns = g.mesh->shading_normal(rh.hit.primID, b);
     si.ns = ns == Vec3(0.f) ? si.ng : ns;
     si.uv = g.mesh->uv_at(rh.hit.primID, b);
   } else {
     si.p = g.sphere->reproject(ray.o + si.t * ray.d);
+    si.p_error = error_gamma(5) * glm::abs(si.p);
     si.ng = si.ns = g.sphere->normal_at(si.p);
     si.uv = g.sphere->uv_at(si.p);
   }

@@ -1,5 +1,6 @@
 #include "scene/triangle_mesh.h"
 
+#include <penumbra/interaction.h>
 #include <penumbra/sampling.h>
 
 namespace penumbra {
@@ -7,6 +8,11 @@ namespace penumbra {
 Vec3 TriangleMesh::position(size_t i, const Vec3& b) const {
   const uint32_t* v = &indices[3 * i];
   return b.x * P[v[0]] + b.y * P[v[1]] + b.z * P[v[2]];
+}
+
+Vec3 TriangleMesh::position_error(size_t i, const Vec3& b) const {
+  const uint32_t* v = &indices[3 * i];
+  return error_gamma(7) * (glm::abs(b.x * P[v[0]]) + glm::abs(b.y * P[v[1]]) + glm::abs(b.z * P[v[2]]));
 }
 
 Vec3 TriangleMesh::shading_normal(size_t i, const Vec3& b) const {

@@ -21,6 +21,8 @@ struct TriangleMesh {
   Vec3 shading_normal(size_t i, const Vec3& b) const;  // interpolated N, or zero without N
   Vec2 uv_at(size_t i, const Vec3& b) const;
   Vec3 position(size_t i, const Vec3& b) const;
+  /// Error bound of position(): gamma_7 (|b0 p0| + |b1 p1| + |b2 p2|) per component (pbrt-v3).
+  Vec3 position_error(size_t i, const Vec3& b) const;
   float area(size_t i) const;
 };
 

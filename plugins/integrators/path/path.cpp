@@ -114,7 +114,7 @@ class PathIntegrator final : public PixelIntegrator {
     if (is_black(f)) return Rgb(0.f);
     // Same leak test as for BSDF sampling, against the geometric normal.
     if ((wi.z * wo.z > 0.f) != (glm::dot(ls->wi, si.ng) * glm::dot(si.wo, si.ng) > 0.f)) return Rgb(0.f);
-    if (scene.occluded(spawn_ray_to(si.p, si.ng, ls->p_light, ls->n_light))) return Rgb(0.f);
+    if (scene.occluded(si.spawn_ray_to(ls->p_light, ls->n_light))) return Rgb(0.f);
     float light_pdf = sl->pmf * ls->pdf;
     if (is_delta_light(sl->light->type())) return f * ls->L / light_pdf;
     float w = power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
