@@ -8,7 +8,7 @@ SECONDS_BUDGET=${1:-60}
 out=build/fuzz
 mkdir -p "$out/corpus"
 find scenes -name '*.pbrt' -exec cp {} "$out/corpus/" \;
-clang++ -std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
+"$(command -v clang++-14 || command -v clang++)" -std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
   -Icore/include -Icore/src \
   core/src/parser/tokenizer.cpp core/src/parser/param_list.cpp core/src/parser/parser.cpp \
   core/src/parser/entity_directives.cpp core/src/parser/transform_directives.cpp \
