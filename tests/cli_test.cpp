@@ -118,7 +118,7 @@ TEST(Cli, WrongValueCountIsLocated) {
 TEST(Cli, UnknownPluginListsAvailable) {
   auto r = render_text("plugin", scene_with("Integrator \"volpath\"\n", ""));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:1: error: unknown integrator 'volpath'; available: path"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:1: error: unknown integrator 'volpath'; available: bdpt, lighttracing, path, sppm"));
 }
 
 TEST(Cli, MissingPlyFileIsLocated) {
@@ -171,7 +171,7 @@ TEST(Cli, BadCommandLineOptionsNameTheOption) {
   EXPECT_THAT(r.err, HasSubstr("/no/such/scene.pbrt"));
   r = test::run_penumbra({"render", kSource + "/scenes/cornell-box/scene.pbrt", "--integrator", "nope", "-q"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("unknown integrator 'nope'; available: path"));
+  EXPECT_THAT(r.err, HasSubstr("unknown integrator 'nope'; available: bdpt, lighttracing, path, sppm"));
 }
 
 TEST(Cli, IntegratorOverrideKeepsParametersTheNewPluginTakes) {

@@ -1,6 +1,7 @@
 #include "commands.h"
 
 #include "registry/registry.h"
+#include "render/merge.h"
 
 #include <fmt/core.h>
 
@@ -26,6 +27,17 @@ int run_render(const RenderSettings& settings) {
   std::fprintf(stderr, "wrote %s: %dx%d, %d spp, %.2f s, %.2f Mrays/s%s\n", s.output.c_str(),
                result.image.width, result.image.height, s.spp, s.seconds, s.mrays_per_second(),
                settings.stats_file.empty() ? "" : fmt::format(", stats in {}", settings.stats_file).c_str());
+  return 0;
+}
+
+int run_merge(const std::vector<std::string>& parts, const std::string& output) {
+  if (fs::path(output).extension() != ".exr")
+    throw Error(fmt::format("merge writes a multilayer EXR: the output '{}' must end in .exr", output));
+  MergeResult merged = merge_parts(parts);
+  for (const auto& note : merged.notes) std::fprintf(stderr, "note: %s\n", note.c_str());
+  write_layered_exr(output, merged.image);
+  std::fprintf(stderr, "merged %zu parts (%d of %d samples per pixel) into %s\n", parts.size(), merged.samples,
+               merged.spp_total, output.c_str());
   return 0;
 }
 

@@ -2,6 +2,7 @@
 //   penumbra                       renders the bundled Cornell box
 //   penumbra render SCENE [opts]   renders a scene, command-line options override the file
 //   penumbra plugins               lists the plugins found and their parameters
+//   penumbra merge PARTS -o OUT    combines the parts of a split render (docs/farm.md)
 #include "commands.h"
 #include "converge.h"
 
@@ -47,6 +48,12 @@ int main(int argc, char** argv) {
   render->add_option("--res", res, "image resolution WIDTHxHEIGHT");
   render->add_option("--stats", settings.stats_file, "write render statistics as JSON");
   render->add_flag("-q,--quiet", settings.quiet, "no progress output");
+  render->add_option("--aov", settings.aovs, "auxiliary outputs as EXR layers: albedo, normal, depth, samples, "
+                     "variance, nonfinite, all")->delimiter(',');
+  int spp_total = 0, spp_count = 0;
+  auto* total_opt = render->add_option("--spp-total", spp_total, "split render: samples per pixel of the whole render")->check(CLI::PositiveNumber);
+  render->add_option("--spp-offset", settings.spp_offset, "split render: index of this part's first sample")->check(CLI::NonNegativeNumber)->needs(total_opt);
+  auto* count_opt = render->add_option("--spp-count", spp_count, "split render: samples in this part (default: the rest)")->check(CLI::PositiveNumber)->needs(total_opt);
 
   penumbra::cli::ConvergeSettings conv;
   std::string conv_configs, conv_res;
@@ -62,6 +69,12 @@ int main(int argc, char** argv) {
   converge->add_option("-o,--output", conv.out_dir, "output folder");
   converge->add_option("--res", conv_res, "image resolution WIDTHxHEIGHT");
   converge->add_option("--threads", conv.threads, "worker threads")->check(CLI::Range(1, 1024));
+
+  std::vector<std::string> merge_parts;
+  std::string merge_output;
+  auto* merge = app.add_subcommand("merge", "Combine the parts of a split render into one image");
+  merge->add_option("parts", merge_parts, "EXR parts written with --spp-total")->required()->check(CLI::ExistingFile);
+  merge->add_option("-o,--output", merge_output, "merged image (.exr)")->required();
 
   std::vector<std::string> plugin_dirs;
   auto* plugins = app.add_subcommand("plugins", "List plugins with their parameters");
@@ -82,6 +95,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*plugins) return penumbra::cli::run_plugins(plugin_dirs);
+    if (*merge) return penumbra::cli::run_merge(merge_parts, merge_output);
     if (*converge) {
       conv.configs = penumbra::cli::parse_configs(conv_configs);
       if (!conv_res.empty()) conv.resolution = parse_resolution(conv_res);
@@ -90,6 +104,8 @@ int main(int argc, char** argv) {
     if (!*render) settings.scene_file = penumbra::cli::default_scene();
     if (*spp_opt) settings.spp = spp;
     if (*seed_opt) settings.seed = seed;
+    if (*total_opt) settings.spp_total = spp_total;
+    if (*count_opt) settings.spp_count = spp_count;
     if (!res.empty()) settings.resolution = parse_resolution(res);
     return penumbra::cli::run_render(settings);
   } catch (const penumbra::Error& e) {

@@ -19,6 +19,9 @@ namespace penumbra {
 /// How much to render, decided by the scene and the command line.
 struct RenderOptions {
   int spp = 16;                // samples per pixel (a maximum when a time budget is set)
+  int first_sample = 0;        // index of the first sample: a part of a split render takes indices
+                               // [first_sample, first_sample + spp) of one sequence (iterations for
+                               // photon mapping, which seeds each part by its first iteration)
   double time_budget = 0.0;    // seconds; 0 means no limit
   int threads = 0;             // 0: all cores
 };

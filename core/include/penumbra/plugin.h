@@ -1,7 +1,7 @@
 // The plugin contract. A plugin is a shared library `penumbra-<kind>-<name>.so` exporting one C
-// function, penumbra_plugin_info(), that describes it: the SDK version it was built against, its
-// kind, name and aliases, a one-line description, its parameter table and a factory. Write it with
-// the PENUMBRA_PLUGIN macro:
+// function, penumbra_plugin_info(), that describes it: the SDK version and compiler it was built
+// with, its kind, name and aliases, a one-line description, its parameter table and a factory.
+// Write it with the PENUMBRA_PLUGIN macro:
 //
 //   static const penumbra::ParamSpec kParams[] = {
 //       {"integer", "maxdepth", "5", "longest path, in bounces"}};
@@ -39,10 +39,12 @@ struct CreateContext {
 
 using PluginFactory = Object* (*)(const CreateContext& ctx);
 
-/// Layout is fixed across SDK versions up to `sdk_version` so that the loader can read it from a
-/// plugin built for another version and refuse it.
+/// The first two fields keep their layout in every SDK version, so that the loader can read them
+/// from a plugin built for another version or compiler and refuse it; it reads nothing else until
+/// both match. (SDK version 1 had no compiler field: such plugins are refused on the version.)
 struct PluginInfo {
   uint32_t sdk_version;
+  const char* compiler;  // PENUMBRA_COMPILER_ID of the plugin's build
   PluginKind kind;
   const char* name;
   const char* const* aliases;  // null-terminated list, may be null
@@ -59,9 +61,10 @@ struct PluginInfo {
 #define PENUMBRA_PLUGIN_WITH_ALIASES(KIND, NAME, DOC, PARAMS, FACTORY, ALIASES)                 \
   extern "C" __attribute__((visibility("default"))) const ::penumbra::PluginInfo*               \
   penumbra_plugin_info() {                                                                     \
-    static const ::penumbra::PluginInfo info{PENUMBRA_SDK_VERSION, ::penumbra::PluginKind::KIND, \
-                                             NAME, ALIASES, DOC, PARAMS,                      \
-                                             sizeof(PARAMS) / sizeof(PARAMS[0]), FACTORY};     \
+    static const ::penumbra::PluginInfo info{PENUMBRA_SDK_VERSION, PENUMBRA_COMPILER_ID,          \
+                                             ::penumbra::PluginKind::KIND, NAME, ALIASES, DOC,  \
+                                             PARAMS, sizeof(PARAMS) / sizeof(PARAMS[0]),        \
+                                             FACTORY};                                          \
     return &info;                                                                              \
   }
 

@@ -25,6 +25,8 @@ static const ParamSpec kFilmParams[] = {
     {"integer", "xresolution", "1280", "image width in pixels"},
     {"integer", "yresolution", "720", "image height in pixels"},
     {"string", "filename", "penumbra.exr", "output image (.exr, .hdr, .tif, .png)"},
+    {"string[]", "aovs", "", "auxiliary outputs written as EXR layers: albedo, normal, depth, samples, "
+                             "variance, nonfinite or all (names or comma-separated lists)"},
     {"unsupported", "cropwindow", "", ""},
     {"unsupported", "pixelbounds", "", ""},
     {"unsupported", "diagonal", "", "Penumbra's film has no physical size"},
@@ -105,14 +107,27 @@ FilterSample PixelFilter::sample(Vec2 u) const {
   return FilterSample{Vec2(x, y), wx * wy};
 }
 
-FilmRgb::FilmRgb(Point2i resolution, PixelFilter filter)
+FilmRgb::FilmRgb(Point2i resolution, PixelFilter filter, AovSet aovs)
     : resolution_(resolution), filter_(std::move(filter)),
-      pixels_(static_cast<size_t>(resolution.x) * resolution.y) {}
+      pixels_(static_cast<size_t>(resolution.x) * resolution.y) {
+  if (aovs.any()) aovs_ = std::make_unique<FilmAovs>(resolution, aovs);
+}
 
 void FilmRgb::add_sample(Point2i pixel, const Rgb& L, float weight) {
-  Pixel& px = pixels_[static_cast<size_t>(pixel.y) * resolution_.x + pixel.x];
+  size_t i = static_cast<size_t>(pixel.y) * resolution_.x + pixel.x;
+  Pixel& px = pixels_[i];
   for (int c = 0; c < 3; ++c) px.rgb[c] += static_cast<double>(weight) * L[c];
   px.weight += weight;
+  if (aovs_) aovs_->add_sample(i, L, weight);
+}
+
+void FilmRgb::add_surface_sample(Point2i pixel, const SurfaceSample& s, float weight) {
+  if (aovs_) aovs_->add_surface(static_cast<size_t>(pixel.y) * resolution_.x + pixel.x, s, weight);
+}
+
+void FilmRgb::add_nonfinite(Point2i pixel) {
+  if (aovs_ && pixel.x >= 0 && pixel.y >= 0 && pixel.x < resolution_.x && pixel.y < resolution_.y)
+    aovs_->add_nonfinite(static_cast<size_t>(pixel.y) * resolution_.x + pixel.x);
 }
 
 void FilmRgb::add_splat(const Vec2& p_raster, const Rgb& v) {

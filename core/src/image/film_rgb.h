@@ -2,6 +2,8 @@
 // thread-safe splat buffer, and filter importance sampling for box, triangle and Gaussian filters.
 #pragma once
 
+#include "image/film_aovs.h"
+
 #include <penumbra/film.h>
 #include <penumbra/params.h>
 
@@ -42,14 +44,21 @@ struct ImageRgb;
 
 class FilmRgb final : public Film {
  public:
-  FilmRgb(Point2i resolution, PixelFilter filter);
+  FilmRgb(Point2i resolution, PixelFilter filter, AovSet aovs = {});
   Point2i resolution() const override { return resolution_; }
   FilterSample sample_filter(Vec2 u) const override { return filter_.sample(u); }
   void add_sample(Point2i pixel, const Rgb& L, float weight) override;
   void add_splat(const Vec2& p_raster, const Rgb& v) override;
+  bool wants_surface_samples() const override { return aovs_ && aovs_->set().surface(); }
+  void add_surface_sample(Point2i pixel, const SurfaceSample& s, float weight) override;
+  /// Counts a discarded non-finite sample for the "nonfinite" AOV; thread-safe.
+  void add_nonfinite(Point2i pixel);
   /// The image: weighted pixel means plus splats divided by `splat_spp`.
   ImageRgb image(double splat_spp) const;
   bool has_splats() const { return splats_ != nullptr; }
+  /// The requested AOVs (empty when none were).
+  AovSet aovs() const { return aovs_ ? aovs_->set() : AovSet{}; }
+  std::vector<ImageLayer> aov_layers() const { return aovs_ ? aovs_->layers() : std::vector<ImageLayer>{}; }
 
  private:
   struct Pixel {
@@ -61,6 +70,7 @@ class FilmRgb final : public Film {
   std::vector<Pixel> pixels_;
   std::unique_ptr<std::atomic<double>[]> splats_;  // allocated on the first splat
   std::once_flag splat_once_;
+  std::unique_ptr<FilmAovs> aovs_;  // null unless AOVs were requested
 };
 
 }  // namespace penumbra

@@ -88,6 +88,13 @@ const LoadedPlugin& Registry::open(const std::string& path, const FileLoc& loc) 
     throw Error(loc, fmt::format("plugin {} was built for Penumbra SDK version {}, but this runtime "
                                  "has SDK version {}; rebuild the plugin against this SDK",
                                  path, info ? info->sdk_version : 0u, PENUMBRA_SDK_VERSION));
+  // Same layout from here on, but objects crossing the boundary need the same C++ ABI as well.
+  std::string compiler = info->compiler ? info->compiler : "unknown";
+  if (compiler != PENUMBRA_COMPILER_ID)
+    throw Error(loc, fmt::format("plugin {} was built with compiler '{}', but this runtime was built "
+                                 "with '{}' (both SDK version {}); rebuild the plugin with the "
+                                 "runtime's compiler",
+                                 path, compiler, PENUMBRA_COMPILER_ID, PENUMBRA_SDK_VERSION));
   return by_path_.emplace(key, LoadedPlugin{info, path}).first->second;
 }
 

@@ -1,6 +1,9 @@
 // The render loop of PixelIntegrator: passes of samples over 16x16 tiles in parallel. Each pixel's
 // samples are taken in index order by one thread at a time, and every sample is a pure function of
-// (pixel, index, seed), so the image is the same bit for bit whatever the thread count.
+// (pixel, index, seed), so the image is the same bit for bit whatever the thread count, and a part
+// of a split render (indices [first_sample, first_sample + spp)) takes exactly its share of them.
+#include "render/surface_sample.h"
+
 #include <penumbra/integrator.h>
 
 #include <tbb/blocked_range.h>
@@ -24,6 +27,7 @@ void PixelIntegrator::render(RenderContext& ctx) {
   Point2i res = film.resolution();
   int tiles_x = (res.x + kTileSize - 1) / kTileSize, tiles_y = (res.y + kTileSize - 1) / kTileSize;
   uint64_t total = static_cast<uint64_t>(res.x) * res.y * static_cast<uint64_t>(opt.spp);
+  const bool surface_aovs = film.wants_surface_samples();
 
   tbb::enumerable_thread_specific<std::unique_ptr<Sampler>> samplers(
       [&] { return ctx.sampler().clone(); });
@@ -42,7 +46,9 @@ void PixelIntegrator::render(RenderContext& ctx) {
           for (int x = x0; x < x1; ++x) {
             Point2i pixel(x, y);
             for (int s = begin; s < end; ++s) {
-              sampler.start_pixel_sample(pixel, static_cast<uint32_t>(s));
+              // A part of a split render takes its own range of the one global sequence.
+              uint32_t index = static_cast<uint32_t>(opt.first_sample + s);
+              sampler.start_pixel_sample(pixel, index);
               FilterSample fs = film.sample_filter(sampler.get_pixel_2d());
               CameraSample cs{Vec2(x + 0.5f, y + 0.5f) + fs.offset, sampler.get_2d()};
               std::optional<Ray> ray = camera.generate_ray(cs);
@@ -52,6 +58,9 @@ void PixelIntegrator::render(RenderContext& ctx) {
                 continue;
               }
               film.add_sample(pixel, L, fs.weight);
+              if (surface_aovs)
+                film.add_surface_sample(pixel, ray ? trace_surface_sample(scene, *ray, pixel, index) : SurfaceSample{},
+                                        fs.weight);
             }
           }
         uint64_t n = static_cast<uint64_t>(x1 - x0) * (y1 - y0) * (end - begin);

@@ -4,9 +4,10 @@
 #include "registry/registry.h"
 #include "render/progress.h"
 #include "render/ray_counter.h"
+#include "render/render_outputs.h"
+#include "render/scene_hash.h"
 #include "scene/scene_builder.h"
 
-#include <penumbra/version.h>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -52,6 +53,7 @@ class Session final : public RenderContext {
     progress_.update(done, total, elapsed(), options_.time_budget);
   }
   void report_nonfinite(Point2i pixel) override {
+    built_.film->add_nonfinite(pixel);
     if (nonfinite_.fetch_add(1) == 0) {
       std::lock_guard<std::mutex> lock(mutex_);
       first_nonfinite_ = {pixel.x, pixel.y};
@@ -131,6 +133,9 @@ RenderResult render(const RenderSettings& settings) {
     desc.film.params.set_int("yresolution", settings.resolution->second);
   }
 
+  SampleRange range = apply_output_settings(settings, desc);
+  std::string hash = scene_hash(desc);
+
   int threads = settings.threads > 0 ? settings.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
 
@@ -141,6 +146,10 @@ RenderResult render(const RenderSettings& settings) {
   options.spp = built.sampler->samples_per_pixel();
   if (settings.time_budget > 0.0 && !settings.spp) options.spp = INT_MAX;
   if (options.spp <= 0) throw Error(desc.sampler.params.loc_of("pixelsamples"), "pixelsamples must be positive");
+  if (range.split) {
+    options.spp = range.count;
+    options.first_sample = range.first;
+  }
   double load_seconds = seconds_since(t0);
 
   Session session(built, options, settings);
@@ -151,6 +160,7 @@ RenderResult render(const RenderSettings& settings) {
 
   RenderResult result;
   result.image = built.film->image(session.completed_spp());
+  result.aovs = built.film->aov_layers();
   if (built.film->has_splats()) built.structures_built.push_back("film_splat_buffer");
   for (const Object* o : {static_cast<const Object*>(built.integrator.get()), static_cast<const Object*>(built.sampler.get())})
     for (auto& name : o->structures_built())
@@ -174,6 +184,10 @@ RenderResult render(const RenderSettings& settings) {
   s.threads = threads;
   s.seed = static_cast<uint32_t>(desc.sampler.params.get_int("seed", 0));
   s.triangles = built.scene->triangle_count();
+  s.scene_hash = hash;
+  s.first_sample = options.first_sample;
+  s.spp_total = range.split ? range.total : s.spp;
+  s.aovs = built.film->aovs().names();
   if (s.nonfinite_samples > 0)
     warning({}, fmt::format("{} non-finite samples were discarded (first at pixel {}, {})",
                             s.nonfinite_samples, s.first_nonfinite_pixel->first,
@@ -205,18 +219,15 @@ std::string stats_json(const RenderStats& s) {
   j["threads"] = s.threads;
   j["seed"] = s.seed;
   j["triangles"] = s.triangles;
+  j["scene_hash"] = s.scene_hash;
+  j["spp_total"] = s.spp_total;
+  j["first_sample"] = s.first_sample;
   return j.dump(2) + "\n";
 }
 
 void write_outputs(const RenderSettings& settings, const RenderResult& result) {
   const RenderStats& s = result.stats;
-  write_image(s.output, result.image,
-              {{"penumbra:version", PENUMBRA_VERSION_STRING},
-               {"penumbra:integrator", s.integrator},
-               {"penumbra:sampler", s.sampler},
-               {"penumbra:spp", std::to_string(s.spp)},
-               {"penumbra:seed", std::to_string(s.seed)},
-               {"penumbra:scene", s.scene_file}});
+  write_render_image(result);
   if (!settings.stats_file.empty()) {
     std::ofstream out(settings.stats_file);
     if (!out) throw Error(fmt::format("cannot write stats file {}", settings.stats_file));

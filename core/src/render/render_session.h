@@ -2,6 +2,7 @@
 // program, the tests and the benchmarks share.
 #pragma once
 
+#include "image/exr_layers.h"
 #include "image/image_io.h"
 
 #include <cstdint>
@@ -31,6 +32,12 @@ struct RenderSettings {
   /// in the callback does not count as render time.
   std::vector<double> snapshot_times;
   std::function<void(double seconds, int spp, const ImageRgb& image)> on_snapshot;
+  std::vector<std::string> aovs;         // --aov NAME[,NAME...], added to the Film's "aovs"
+  /// Split renders (docs/farm.md): with --spp-total N this render takes sample indices
+  /// [spp_offset, spp_offset + spp_count) of one N-sample render; the default count is the rest.
+  std::optional<int> spp_total;
+  int spp_offset = 0;
+  std::optional<int> spp_count;
 };
 
 struct RenderStats {
@@ -48,11 +55,16 @@ struct RenderStats {
   int threads = 0;
   uint32_t seed = 0;
   size_t triangles = 0;
+  std::string scene_hash;      // render_outputs.h
+  int spp_total = 0;           // samples of the whole render this one is a part of (= spp unsplit)
+  int first_sample = 0;        // index of this render's first sample
+  std::string aovs;            // AOVs written, e.g. "albedo,samples"
   double mrays_per_second() const { return seconds > 0 ? rays / seconds * 1e-6 : 0.0; }
 };
 
 struct RenderResult {
   ImageRgb image;
+  std::vector<ImageLayer> aovs;  // written with the beauty as EXR layers
   RenderStats stats;
 };
 

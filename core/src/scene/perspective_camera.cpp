@@ -41,6 +41,12 @@ PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_
   if (lens_radius_ < 0.f) throw Error(params.loc_of("lensradius"), "lensradius must be >= 0");
   if (!(focal_distance_ > 0.f))
     throw Error(params.loc_of("focaldistance"), "focaldistance must be > 0");
+  from_world_ = glm::inverse(to_world_);
+  // generate_ray() maps the raster rectangle linearly onto the screen window scaled by tan(fov/2)
+  // on the z = 1 plane, so that rectangle is the film every importance density refers to.
+  Vec2 extent = (screen_max_ - screen_min_) * tan_half_fov_;
+  film_area_ = std::abs(extent.x * extent.y);
+  lens_area_ = lens_radius_ > 0.f ? Pi * lens_radius_ * lens_radius_ : 1.f;
 }
 
 std::optional<Ray> PerspectiveCamera::generate_ray(const CameraSample& s) const {
@@ -57,6 +63,66 @@ std::optional<Ray> PerspectiveCamera::generate_ray(const CameraSample& s) const 
   Vec3 o = Vec3(to_world_ * Vec4(origin, 1.f));
   Vec3 d = glm::normalize(Vec3(to_world_ * Vec4(dir, 0.f)));
   return Ray{o, d, Infinity};
+}
+
+}  // namespace penumbra
+
+namespace penumbra {
+
+bool PerspectiveCamera::raster_of(const Vec3& o, const Vec3& d, Vec2* p_raster, float* cos_theta) const {
+  *cos_theta = d.z;
+  if (!(d.z > 0.f)) return false;
+  // A thin lens maps the ray to where it crosses the plane in focus; every ray of a film point
+  // passes through the same point there. A pinhole's rays all start at the origin.
+  float plane = lens_radius_ > 0.f ? focal_distance_ : 1.f;
+  Vec3 p = o + d * ((plane - o.z) / d.z);
+  Vec2 screen = Vec2(p.x, p.y) / (plane * tan_half_fov_);
+  Vec2 r((screen.x - screen_min_.x) / (screen_max_.x - screen_min_.x) * resolution_.x,
+         (screen_max_.y - screen.y) / (screen_max_.y - screen_min_.y) * resolution_.y);
+  if (p_raster) *p_raster = r;
+  return r.x >= 0.f && r.y >= 0.f && r.x < resolution_.x && r.y < resolution_.y;
+}
+
+Rgb PerspectiveCamera::We(const Ray& ray, Vec2* p_raster) const {
+  Vec3 o = Vec3(from_world_ * Vec4(ray.o, 1.f));
+  Vec3 d = glm::normalize(Vec3(from_world_ * Vec4(ray.d, 0.f)));
+  float cos_theta;
+  if (!raster_of(o, d, p_raster, &cos_theta)) return Rgb(0.f);
+  // On the z = 1 plane dA = r^2 / cos(theta) dw with r = 1 / cos(theta), so a density uniform over
+  // the film is 1 / (A cos^3) per solid angle; dividing once more by cos(theta) normalises We cos.
+  float cos2 = cos_theta * cos_theta;
+  return Rgb(1.f / (film_area_ * lens_area_ * cos2 * cos2));
+}
+
+void PerspectiveCamera::pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) const {
+  Vec3 o = Vec3(from_world_ * Vec4(ray.o, 1.f));
+  Vec3 d = glm::normalize(Vec3(from_world_ * Vec4(ray.d, 0.f)));
+  float cos_theta;
+  if (!raster_of(o, d, nullptr, &cos_theta)) {
+    *pdf_pos = *pdf_dir = 0.f;
+    return;
+  }
+  *pdf_pos = 1.f / lens_area_;
+  *pdf_dir = 1.f / (film_area_ * cos_theta * cos_theta * cos_theta);
+}
+
+std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Vec2 u) const {
+  Vec3 lens(0.f);
+  if (lens_radius_ > 0.f) lens = Vec3(lens_radius_ * sample_uniform_disk_concentric(u), 0.f);
+  CameraWiSample s;
+  s.p_lens = Vec3(to_world_ * Vec4(lens, 1.f));
+  Vec3 d = s.p_lens - p_ref;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) return std::nullopt;
+  s.wi = d / std::sqrt(dist2);
+  Vec3 axis = glm::normalize(Vec3(to_world_ * Vec4(0.f, 0.f, 1.f, 0.f)));
+  float cos_lens = std::abs(glm::dot(axis, s.wi));
+  if (cos_lens == 0.f) return std::nullopt;
+  s.We = We(Ray{s.p_lens, -s.wi, Infinity}, &s.p_raster);
+  if (is_black(s.We)) return std::nullopt;
+  // Uniform by lens area, converted to solid angle at the reference point.
+  s.pdf = dist2 / (cos_lens * lens_area_);
+  return s;
 }
 
 }  // namespace penumbra

@@ -144,7 +144,9 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     throw Error(desc.filter.loc,
                 fmt::format("unsupported pixel filter '{}'; available: box, gaussian, triangle", filter_type));
   desc.filter.params.validate(pixel_filter_params(filter_type), fmt::format("filter '{}'", filter_type));
-  out.film = std::make_unique<FilmRgb>(res, PixelFilter(filter_type, desc.filter.params, desc.filter.loc));
+  const Param* aovs = desc.film.params.find("aovs");
+  AovSet aov_set = aovs ? parse_aovs(aovs->strings, aovs->loc) : AovSet{};
+  out.film = std::make_unique<FilmRgb>(res, PixelFilter(filter_type, desc.filter.params, desc.filter.loc), aov_set);
 
   if (!desc.camera.type.empty() && desc.camera.type != "perspective")
     throw Error(desc.camera.loc,

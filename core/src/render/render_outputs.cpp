@@ -1,0 +1,123 @@
+#include "render/render_outputs.h"
+
+#include "image/film_aovs.h"
+
+#include <penumbra/version.h>
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+#include <regex>
+
+namespace penumbra {
+
+namespace {
+
+bool is_exr(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".exr";
+}
+
+}  // namespace
+
+SampleRange apply_output_settings(const RenderSettings& settings, SceneDescription& desc) {
+  SampleRange range;
+  bool has_part = settings.spp_offset != 0 || settings.spp_count.has_value();
+  if (has_part && !settings.spp_total) throw Error("--spp-offset and --spp-count need --spp-total");
+  if (settings.spp_total) {
+    int n = *settings.spp_total;
+    if (settings.spp) throw Error("--spp and --spp-total exclude each other: a part's size is --spp-count");
+    if (settings.time_budget > 0.0) throw Error("--time cannot split a render: parts need fixed sample ranges");
+    if (n <= 0) throw Error("--spp-total must be positive");
+    if (settings.spp_offset < 0 || settings.spp_offset >= n)
+      throw Error(fmt::format("--spp-offset {} is outside the {} samples of --spp-total", settings.spp_offset, n));
+    int count = settings.spp_count.value_or(n - settings.spp_offset);
+    if (count <= 0 || count > n - settings.spp_offset)
+      throw Error(fmt::format("--spp-count {} does not fit: samples {}-{} of {} remain after --spp-offset {}",
+                              count, settings.spp_offset, n, n, settings.spp_offset));
+    range = SampleRange{n, settings.spp_offset, count, true};
+    desc.sampler.params.set_int("pixelsamples", n);
+  }
+
+  std::vector<std::string> aovs;
+  FileLoc loc;
+  if (const Param* p = desc.film.params.find("aovs")) {
+    aovs = p->strings;
+    loc = p->loc;
+  }
+  parse_aovs(settings.aovs);  // a wrong --aov name is reported without a scene location
+  aovs.insert(aovs.end(), settings.aovs.begin(), settings.aovs.end());
+  if (range.split) aovs.push_back("samples");
+  AovSet set = parse_aovs(aovs, loc);
+  if (set.any()) desc.film.params.set_string("aovs", set.names());
+
+  std::string output = settings.output;
+  if (output.empty()) {
+    const Param* f = desc.film.params.find("filename");
+    output = f && !f->strings.empty() ? f->strings[0] : "penumbra.exr";
+  }
+  if (range.split && !is_exr(output))
+    throw Error(fmt::format("a part of a split render must be written as .exr (for `penumbra merge`), not '{}'",
+                            output));
+  if (set.any() && !is_exr(output))
+    throw Error(fmt::format("AOVs ({}) are written as EXR layers: the output '{}' must be .exr", set.names(), output));
+  return range;
+}
+
+std::string format_ranges(const std::vector<std::pair<int, int>>& ranges) {
+  std::string out;
+  for (const auto& [a, b] : ranges) out += fmt::format("{}{}-{}", out.empty() ? "" : ",", a, b);
+  return out;
+}
+
+std::vector<std::pair<int, int>> parse_ranges(const std::string& text) {
+  static const std::regex re(R"((\d+)-(\d+))");
+  std::vector<std::pair<int, int>> out;
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t end = text.find(',', start);
+    if (end == std::string::npos) end = text.size();
+    std::string item = text.substr(start, end - start);
+    std::smatch m;
+    if (!std::regex_match(item, m, re) || std::stoll(m[1]) >= std::stoll(m[2]) || std::stoll(m[2]) > INT32_MAX)
+      throw Error(fmt::format("malformed sample range '{}' (expected FIRST-END[,FIRST-END...])", text));
+    out.emplace_back(std::stoi(m[1]), std::stoi(m[2]));
+    start = end + 1;
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> render_metadata(const RenderStats& s) {
+  int first = s.first_sample;
+  return {{"penumbra:version", PENUMBRA_VERSION_STRING},
+          {"penumbra:scene_hash", s.scene_hash},
+          {"penumbra:integrator", s.integrator},
+          {"penumbra:sampler", s.sampler},
+          {"penumbra:spp", std::to_string(s.spp)},
+          {"penumbra:spp_total", std::to_string(s.spp_total)},
+          {"penumbra:seed", std::to_string(s.seed)},
+          {"penumbra:sample_range", s.spp > 0 ? format_ranges({{first, first + s.spp}}) : ""},
+          {"penumbra:scene", s.scene_file},
+          {"penumbra:aovs", s.aovs}};
+}
+
+void write_render_image(const RenderResult& result) {
+  const RenderStats& s = result.stats;
+  if (result.aovs.empty()) {
+    write_image(s.output, result.image, render_metadata(s));
+    return;
+  }
+  LayeredImage image;
+  image.width = result.image.width;
+  image.height = result.image.height;
+  image.layers.push_back(ImageLayer{"", {"R", "G", "B"}, result.image.pixels});
+  image.layers.insert(image.layers.end(), result.aovs.begin(), result.aovs.end());
+  image.metadata = render_metadata(s);
+  write_layered_exr(s.output, image);
+}
+
+}  // namespace penumbra

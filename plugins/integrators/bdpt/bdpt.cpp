@@ -1,0 +1,192 @@
+// Integrator "bdpt": bidirectional path tracing (Veach 1997, ch. 10; pbrt-v3's design). Each pixel
+// sample traces a camera subpath and a light subpath (light chosen by power, or uniformly) and
+// evaluates every strategy (s, t) that gives a path of at most maxdepth bounces:
+//   s = 0       the camera subpath hits an emitter (area lights, environment lights);
+//   s = 1       next-event estimation with the light's own sample_li();
+//   t = 1       the light subpath connects to the lens (camera sample_wi) and splats on the film;
+//   s, t >= 2   a shadow ray joins light vertex s-1 and camera vertex t-1.
+// The strategies are combined by MIS (power heuristic by default) computed from the path's forward
+// and reverse densities (mis.h, subpath.h: formulation and reasons). Delta lights and specular
+// lobes are never connected to; environment and distant lights are directions whose emitted paths
+// start on a disk covering the scene. Subpaths use Russian roulette after rrdepth bounces (kept out of
+// the MIS densities, see subpath.h); set rrdepth above maxdepth for pbrt-v3's behaviour (none).
+//
+// | parameter                | default | meaning                                                |
+// |--------------------------|---------|--------------------------------------------------------|
+// | integer maxdepth         | 5       | longest path in bounces (pbrt's convention, as "path") |
+// | integer rrdepth          | 3       | bounces of a subpath before Russian roulette           |
+// | string lightsampler      | power   | light choice: power or uniform                         |
+// | string misheuristic      | power   | power (beta = 2) or balance                            |
+// | bool visualizestrategies | false   | write each strategy's contribution, weighted and not   |
+// | bool visualizeweights    | false   | write each strategy's mean MIS weight                  |
+// | string visualizeprefix   | bdpt_   | path prefix of those images                            |
+//
+// The strategy images are <prefix>d<depth>_s<s>_t<t>.exr (weighted: they sum to the image when the
+// filter is a box), ..._unweighted.exr (each alone estimates the depth-d image, where the strategy can
+// sample it) and ..._weight.exr (mean weight over the samples the strategy found light with).
+#include "render_loop.h"
+#include "subpath.h"
+
+#include <penumbra/image.h>
+#include <penumbra/plugin.h>
+
+#include <fmt/core.h>
+
+#include <map>
+
+namespace {
+
+using namespace penumbra;
+using namespace penumbra::bdpt;
+
+// Per-strategy images for visualizestrategies / visualizeweights (double sums, one writer at a time).
+class StrategyImages {
+ public:
+  StrategyImages(Point2i res, int max_depth) : res_(res), max_depth_(max_depth) {}
+  static int tag(int s, int t, int max_depth) { return t * (max_depth + 3) + s; }
+
+  void add(const TaggedSplat& ts) {
+    int x = static_cast<int>(std::floor(ts.p_raster.x)), y = static_cast<int>(std::floor(ts.p_raster.y));
+    if (x < 0 || y < 0 || x >= res_.x || y >= res_.y) return;
+    Buffers& b = buffers_[ts.tag];
+    if (b.weighted.empty()) {
+      size_t n = static_cast<size_t>(res_.x) * res_.y;
+      b.weighted.assign(3 * n, 0.0);
+      b.unweighted.assign(3 * n, 0.0);
+      b.weight.assign(n, 0.0);
+      b.count.assign(n, 0.0);
+    }
+    size_t i = static_cast<size_t>(y) * res_.x + x;
+    for (int c = 0; c < 3; ++c) {
+      b.weighted[3 * i + c] += ts.weighted[c];
+      b.unweighted[3 * i + c] += ts.unweighted[c];
+    }
+    b.weight[i] += ts.weight;
+    b.count[i] += 1.0;
+  }
+
+  void write(const std::string& prefix, int spp, bool strategies, bool weights) const {
+    for (int t = 1; t <= max_depth_ + 2; ++t)
+      for (int s = 0; s <= max_depth_ + 1; ++s) {
+        int depth = s + t - 2;
+        if ((s == 1 && t == 1) || depth < 0 || depth > max_depth_) continue;
+        auto it = buffers_.find(tag(s, t, max_depth_));
+        std::string name = fmt::format("{}d{:02}_s{:02}_t{:02}", prefix, depth, s, t);
+        const Buffers* b = it == buffers_.end() ? nullptr : &it->second;
+        if (strategies) {
+          write_image(name + ".exr", image(b ? &b->weighted : nullptr, 1.0 / spp));
+          write_image(name + "_unweighted.exr", image(b ? &b->unweighted : nullptr, 1.0 / spp));
+        }
+        if (weights) {
+          ImageRgb img = image(nullptr, 0.0);
+          if (b)
+            for (size_t i = 0; i < b->weight.size(); ++i)
+              for (int c = 0; c < 3; ++c)
+                img.pixels[3 * i + c] = b->count[i] > 0 ? static_cast<float>(b->weight[i] / b->count[i]) : 0.f;
+          write_image(name + "_weight.exr", img);
+        }
+      }
+  }
+
+ private:
+  struct Buffers {
+    std::vector<double> weighted, unweighted, weight, count;
+  };
+  ImageRgb image(const std::vector<double>* rgb, double scale) const {
+    ImageRgb img;
+    img.width = res_.x;
+    img.height = res_.y;
+    img.pixels.assign(3 * static_cast<size_t>(res_.x) * res_.y, 0.f);
+    if (rgb)
+      for (size_t i = 0; i < rgb->size(); ++i) img.pixels[i] = static_cast<float>((*rgb)[i] * scale);
+    return img;
+  }
+  Point2i res_;
+  int max_depth_;
+  std::map<int, Buffers> buffers_;
+};
+
+class BdptIntegrator final : public Integrator {
+ public:
+  BdptIntegrator(Config config, bool uniform_lights, bool vis_strategies, bool vis_weights, std::string prefix)
+      : config_(config), uniform_lights_(uniform_lights), vis_strategies_(vis_strategies),
+        vis_weights_(vis_weights), prefix_(std::move(prefix)) {}
+
+  void render(RenderContext& rc) override {
+    const Scene& scene = rc.scene();
+    LightChooser chooser(scene, uniform_lights_);
+    Context ctx{scene, chooser, config_};
+    bool visualize = vis_strategies_ || vis_weights_;
+    StrategyImages images(rc.film().resolution(), config_.max_depth);
+    int max_depth = config_.max_depth;
+
+    auto sample = [&](Point2i pixel, uint32_t index, const CameraSample& cs, Sampler& sampler, SampleOutputs& out) {
+      thread_local std::vector<Vertex> camera_path, light_path;
+      camera_path.resize(max_depth + 2);
+      light_path.resize(max_depth + 1);
+      std::optional<Ray> ray = scene.camera().generate_ray(cs);
+      if (!ray) return Rgb(0.f);
+      PathSampler ps(sampler, pixel, index);
+      int nc = camera_subpath(ctx, *ray, ps, camera_path.data());
+      int nl = light_subpath(ctx, ps, light_path.data());
+      Rgb L(0.f);
+      for (int t = 1; t <= nc; ++t)
+        for (int s = 0; s <= nl; ++s) {
+          int depth = s + t - 2;
+          if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
+          Connection c = connect(ctx, light_path.data(), s, camera_path.data(), t, ps);
+          if (is_black(c.L)) continue;
+          if (c.splat)
+            out.splats.push_back(Splat{c.p_raster, c.weighted});
+          else
+            L += c.weighted;
+          if (visualize)
+            out.tagged.push_back(TaggedSplat{StrategyImages::tag(s, t, max_depth), c.splat ? c.p_raster : cs.p_film,
+                                             c.weighted, c.L, static_cast<float>(c.weight)});
+        }
+      return L;
+    };
+    auto commit = [&](const TaggedSplat& ts) { images.add(ts); };
+    int spp = render_with_splats(rc, sample, visualize ? TaggedCommitFn(commit) : TaggedCommitFn());
+    if (visualize && spp > 0) images.write(prefix_, spp, vis_strategies_, vis_weights_);
+  }
+
+ private:
+  Config config_;
+  bool uniform_lights_, vis_strategies_, vis_weights_;
+  std::string prefix_;
+};
+
+const ParamSpec kParams[] = {
+    {"integer", "maxdepth", "5", "longest path in bounces"},
+    {"integer", "rrdepth", "3", "bounces of a subpath before Russian roulette may end it"},
+    {"string", "lightsampler", "power", "light selection: power or uniform"},
+    {"string", "misheuristic", "power", "MIS heuristic: power or balance"},
+    {"bool", "visualizestrategies", "false", "write each strategy's contribution (weighted and unweighted)"},
+    {"bool", "visualizeweights", "false", "write each strategy's mean MIS weight"},
+    {"string", "visualizeprefix", "bdpt_", "path prefix of the strategy images"},
+    {"unsupported", "regularize", "", "path regularisation is not implemented"},
+};
+
+Object* create(const CreateContext& ctx) {
+  const ParamSet& p = ctx.params;
+  Config config;
+  config.max_depth = p.get_int("maxdepth");
+  if (config.max_depth < 0) throw Error(p.loc_of("maxdepth"), "maxdepth must be >= 0");
+  config.rr_depth = p.get_int("rrdepth");
+  if (config.rr_depth < 1) throw Error(p.loc_of("rrdepth"), "rrdepth must be >= 1");
+  std::string ls = p.get_string("lightsampler");
+  if (ls != "power" && ls != "uniform")
+    throw Error(p.loc_of("lightsampler"), "lightsampler '" + ls + "' is not supported; available: power, uniform");
+  std::string h = p.get_string("misheuristic");
+  if (h != "power" && h != "balance")
+    throw Error(p.loc_of("misheuristic"), "misheuristic '" + h + "' is not supported; available: power, balance");
+  config.heuristic = h == "power" ? MisHeuristic::Power : MisHeuristic::Balance;
+  return new BdptIntegrator(config, ls == "uniform", p.get_bool("visualizestrategies"), p.get_bool("visualizeweights"),
+                            p.get_string("visualizeprefix"));
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Integrator, "bdpt", "bidirectional path tracer with multiple importance sampling of every strategy",
+                kParams, create)

@@ -1,0 +1,435 @@
+#include "subpath.h"
+
+#include <algorithm>
+
+namespace penumbra::bdpt {
+
+namespace {
+
+bool is_at_infinity(const Light* light) {
+  return light->type() == LightType::Infinite || light->type() == LightType::DeltaDirection;
+}
+
+// Area density at `to` of a solid-angle density at `from` (vertices at infinity keep solid angle).
+float convert_density(float pdf_dir, const Vertex& from, const Vertex& to) {
+  if (to.infinite) return pdf_dir;
+  Vec3 d = to.p - from.p;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) return 0.f;
+  float pdf = pdf_dir / dist2;
+  if (to.on_surface()) pdf *= std::abs(glm::dot(to.ng, d)) / std::sqrt(dist2);
+  return pdf;
+}
+
+// Veach's adjoint correction for shading normals (importance transport only): wo towards the
+// previous vertex, wi towards the next.
+float shading_correction(const Vertex& v, const Vec3& wo, const Vec3& wi) {
+  float num = std::abs(glm::dot(wo, v.ns)) * std::abs(glm::dot(wi, v.ng));
+  float den = std::abs(glm::dot(wo, v.ng)) * std::abs(glm::dot(wi, v.ns));
+  return den == 0.f ? 0.f : num / den;
+}
+
+bool leaks(const Vertex& v, const Vec3& wo, const Vec3& wi) {
+  bool reflect_shading = glm::dot(wi, v.ns) * glm::dot(wo, v.ns) > 0.f;
+  bool reflect_geometric = glm::dot(wi, v.ng) * glm::dot(wo, v.ng) > 0.f;
+  return reflect_shading != reflect_geometric;
+}
+
+// Surfaces know their error bound; other points (light samples, emitted-ray origins) are estimated
+// from their magnitude, as the SDK does for points it is handed.
+Vec3 error_of(const Vertex& v) { return v.kind == VertexKind::Surface ? v.p_error : point_error_bound(v.p); }
+
+// Shadow ray from vertex v to a point that is not a path vertex (light sample, lens point).
+Ray shadow_ray(const Vertex& v, const Vec3& p1, const Vec3& n1) {
+  return spawn_ray_to(v.p, error_of(v), v.ng, p1, point_error_bound(p1), n1);
+}
+
+Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMode mode) {
+  Vertex v;
+  v.kind = VertexKind::Surface;
+  v.p = si.p;
+  v.p_error = si.p_error;
+  v.ng = si.ng;
+  v.ns = si.ns;
+  v.shading = si.shading;
+  v.uv = si.uv;
+  v.wo = si.wo;
+  v.bsdf = si.bsdf;
+  v.light = si.area_light;
+  v.beta = beta;
+  v.mode = mode;
+  return v;
+}
+
+// Extends path[0 .. n-1] (n >= 1, path[n-1] the start point) by at most `max_vertices` scattering
+// vertices; returns how many were added. The stored densities are evaluated between the vertices'
+// positions rather than taken from the sampled directions: spawned rays start a few ULPs off the
+// surface, and for close vertices the two differ by up to 1e-3, which would make the weights of
+// different strategies for the same path disagree by as much.
+int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, TransportMode mode, Vertex* path,
+                int max_vertices) {
+  if (max_vertices <= 0) return 0;
+  const Scene& scene = ctx.scene;
+  float roulette_scale = std::max(max_component(beta), 1e-30f);
+  int added = 0;
+  for (;;) {
+    Vertex& prev = path[added];
+    Vertex& v = path[added + 1];
+    Vertex* before = added > 0 ? &path[added - 1] : nullptr;
+    std::optional<SurfaceInteraction> si = scene.intersect(ray);
+    if (si) {
+      v = surface_vertex(*si, beta, mode);
+    } else if (mode == TransportMode::Radiance && !scene.infinite_lights().empty()) {
+      // Camera rays that escape may see environment lights: keep them as an endpoint at infinity.
+      v = Vertex{};
+      v.kind = VertexKind::Light;
+      v.infinite = true;
+      v.w_light = -ray.d;
+      v.p = ray.o;
+      v.beta = beta;
+    } else {
+      break;
+    }
+    if (!prev.delta) {
+      v.pdf_fwd = pdf_area(ctx, before, prev, v);  // solid angle for a vertex at infinity
+      if (before) before->pdf_rev = pdf_area(ctx, &v, prev, *before);
+    }
+    ++added;
+    if (!si || added >= max_vertices) break;
+
+    int level = added - 1;
+    ps.seek(mode == TransportMode::Radiance ? PathSampler::camera_bounce(level) : PathSampler::light_bounce(level));
+    float u_lobe = ps.get_1d();
+    Vec2 u_dir = ps.get_2d();
+    float u_rr = ps.get_1d();
+
+    const Bsdf& bsdf = *v.bsdf;
+    ShadingContext sctx{v.uv, mode};
+    Vec3 wo = v.shading.to_local(v.wo);
+    std::optional<BsdfSample> bs = bsdf.flags() ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
+    if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
+    Vec3 wi = v.shading.to_world(bs->wi);
+    if (leaks(v, v.wo, wi)) break;
+    Rgb scatter = bs->f * std::abs(bs->wi.z) / bs->pdf;
+    if (mode == TransportMode::Importance) scatter *= shading_correction(v, v.wo, wi);
+    beta *= scatter;
+    // A specular choice generates both neighbours with a delta: their densities stay 0.
+    v.delta = bs->is_specular();
+
+    if (added >= ctx.config.rr_depth) {
+      // Throughput relative to the subpath's start, so light and camera paths are treated alike.
+      float q = std::max(0.f, 1.f - max_component(beta) / roulette_scale);
+      if (u_rr < q) break;
+      beta /= 1.f - q;
+    }
+    if (!is_finite(beta) || is_black(beta)) break;
+    ray = Ray{offset_ray_origin(v.p, v.p_error, v.ng, wi), wi, Infinity};
+  }
+  return added;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+std::optional<SampledLight> LightChooser::sample(float u) const {
+  if (!uniform_) return scene_.sample_light(u);
+  auto lights = scene_.lights();
+  if (lights.empty()) return std::nullopt;
+  size_t i = std::min(static_cast<size_t>(u * lights.size()), lights.size() - 1);
+  return SampledLight{lights[i], 1.f / lights.size()};
+}
+
+float LightChooser::pmf(const Light* light) const {
+  if (!uniform_) return scene_.light_pmf(light);
+  return scene_.lights().empty() ? 0.f : 1.f / scene_.lights().size();
+}
+
+bool Vertex::connectible() const {
+  switch (kind) {
+    case VertexKind::Camera: return true;
+    case VertexKind::Light: return !infinite;  // a direction cannot be connected to deterministically
+    case VertexKind::Surface: return bsdf && bsdf->flags() != 0 && !bsdf->is_specular_only();
+  }
+  return false;
+}
+
+Vec3 direction_to(const Vertex& from, const Vertex& to) {
+  if (to.infinite) return -to.w_light;
+  return glm::normalize(to.p - from.p);
+}
+
+Rgb Vertex::f(const Vertex& next) const {
+  if (kind != VertexKind::Surface) return Rgb(0.f);
+  Vec3 wi = direction_to(*this, next);
+  if (leaks(*this, wo, wi)) return Rgb(0.f);
+  Rgb value = bsdf->f(shading.to_local(wo), shading.to_local(wi), ShadingContext{uv, mode});
+  if (mode == TransportMode::Importance) value *= shading_correction(*this, wo, wi);
+  return value;
+}
+
+float pdf_light_dir(const Vertex& cur, const Vertex& next) {
+  const Light* light = cur.light;
+  if (!light) return 0.f;
+  float pdf_pos, pdf_dir;
+  if (cur.infinite) {
+    // Emitted rays start on a disk facing the scene: the density at `next` is the disk's, projected.
+    light->pdf_le(Ray{cur.p, cur.w_light}, Vec3(0.f), &pdf_pos, &pdf_dir);
+    return next.on_surface() ? pdf_pos * std::abs(glm::dot(next.ng, cur.w_light)) : pdf_pos;
+  }
+  Vec3 w = direction_to(cur, next);
+  light->pdf_le(Ray{cur.p, w}, cur.ng, &pdf_pos, &pdf_dir);
+  return convert_density(pdf_dir, cur, next);
+}
+
+float pdf_light_origin(const Context& ctx, const Vertex& cur, const Vertex& next) {
+  const Light* light = cur.light;
+  if (!light) return 0.f;
+  float pmf = ctx.lights.pmf(light);
+  float pdf_pos, pdf_dir;
+  switch (light->type()) {
+    case LightType::DeltaPosition:
+    case LightType::DeltaDirection:
+      return pmf;  // a delta (in position or direction): counts as 1, like every other delta
+    case LightType::Infinite:
+      light->pdf_le(Ray{cur.p, cur.w_light}, Vec3(0.f), &pdf_pos, &pdf_dir);
+      return pmf * pdf_dir;  // the origin of an environment path is its direction
+    case LightType::Area:
+      light->pdf_le(Ray{cur.p, direction_to(cur, next)}, cur.ng, &pdf_pos, &pdf_dir);
+      return pmf * pdf_pos;
+  }
+  return 0.f;
+}
+
+float pdf_area(const Context& ctx, const Vertex* prev, const Vertex& cur, const Vertex& next) {
+  if (cur.kind == VertexKind::Light || (cur.kind == VertexKind::Surface && !prev)) return pdf_light_dir(cur, next);
+  Vec3 wn = direction_to(cur, next);
+  if (cur.kind == VertexKind::Camera) {
+    float pdf_pos, pdf_dir;
+    ctx.scene.camera().pdf_we(Ray{cur.p, wn}, &pdf_pos, &pdf_dir);
+    return convert_density(pdf_dir, cur, next);
+  }
+  Vec3 wp = direction_to(cur, *prev);
+  float pdf_dir = cur.bsdf->pdf(cur.shading.to_local(wp), cur.shading.to_local(wn), ShadingContext{cur.uv, cur.mode});
+  return convert_density(pdf_dir, cur, next);
+}
+
+double next_event_ratio(const Vertex& x0, const Vertex& x1) {
+  if (!x0.light || x0.light->type() != LightType::Area || !x1.on_surface()) return 1.0;
+  Vec3 d = x0.p - x1.p;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) return 1.0;
+  Vec3 wi = d / std::sqrt(dist2);
+  SurfaceInteraction hit;
+  hit.p = x0.p;
+  hit.ng = x0.ng;
+  hit.ns = x0.ng;
+  hit.uv = x0.uv;
+  float pdf_solid_angle = x0.light->pdf_li(LightSampleContext{x1.p, x1.ng}, wi, hit);
+  float pdf_pos, pdf_dir;
+  x0.light->pdf_le(Ray{x0.p, -wi}, x0.ng, &pdf_pos, &pdf_dir);
+  if (!(pdf_pos > 0.f)) return 1.0;
+  double nee_area = static_cast<double>(pdf_solid_angle) * std::abs(glm::dot(x0.ng, wi)) / dist2;
+  return nee_area / pdf_pos;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+int camera_subpath(const Context& ctx, const Ray& ray, PathSampler& ps, Vertex* path) {
+  Vertex& cam = path[0];
+  cam = Vertex{};
+  cam.kind = VertexKind::Camera;
+  cam.p = ray.o;
+  cam.beta = Rgb(1.f);  // We cos / (pdf_pos pdf_dir) = 1 for every camera ray
+  float pdf_dir;
+  ctx.scene.camera().pdf_we(ray, &cam.pdf_fwd, &pdf_dir);
+  return 1 + random_walk(ctx, ray, ps, Rgb(1.f), TransportMode::Radiance, path, ctx.config.max_depth + 1);
+}
+
+int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
+  ps.seek(PathSampler::kLightChoice);
+  float u_light = ps.get_1d();
+  Vec2 u_pos = ps.get_2d(), u_dir = ps.get_2d();
+  std::optional<SampledLight> sl = ctx.lights.sample(u_light);
+  if (!sl || !(sl->pmf > 0.f)) return 0;
+  std::optional<LightLeSample> le = sl->light->sample_le(u_pos, u_dir);
+  if (!le || !(le->pdf_pos > 0.f) || !(le->pdf_dir > 0.f) || is_black(le->L)) return 0;
+
+  Vertex& y0 = path[0];
+  y0 = Vertex{};
+  y0.kind = VertexKind::Light;
+  y0.light = sl->light;
+  y0.p = le->ray.o;
+  y0.ng = le->n;
+  y0.infinite = is_at_infinity(sl->light);
+  y0.w_light = le->ray.d;
+  y0.beta = Rgb(1.f / (sl->pmf * le->pdf_pos));  // emission is evaluated per connection
+  y0.mode = TransportMode::Importance;
+
+  float cos0 = le->n != Vec3(0.f) ? std::abs(glm::dot(le->n, le->ray.d)) : 1.f;
+  Rgb beta = le->L * cos0 / (sl->pmf * le->pdf_pos * le->pdf_dir);
+  int n = random_walk(ctx, le->ray, ps, beta, TransportMode::Importance, path, ctx.config.max_depth);
+  y0.pdf_fwd = pdf_light_origin(ctx, y0, n > 0 ? path[1] : y0);
+  return n + 1;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
+                  const Vertex* light_end, const Vertex* camera_end) {
+  if (s + t == 2) return 1.0;
+  int k = s + t - 1;
+  auto L = [&](int i) -> const Vertex& { return (i == s - 1 && light_end) ? *light_end : light[i]; };
+  auto C = [&](int j) -> const Vertex& { return (j == t - 1 && camera_end) ? *camera_end : camera[j]; };
+
+  thread_local std::vector<MisVertex> mv;
+  thread_local std::vector<double> ratios;
+  mv.assign(k + 1, MisVertex{});
+  ratios.assign(k + 1, 0.0);
+  for (int i = 0; i < s; ++i) mv[i] = {L(i).pdf_fwd, L(i).pdf_rev, L(i).delta};
+  for (int i = s; i <= k; ++i) {
+    const Vertex& v = C(k - i);
+    mv[i] = {v.pdf_rev, v.pdf_fwd, v.delta};
+  }
+
+  // The densities the connection changes: the two vertices on each side of the new edge see new
+  // neighbours, and the connected vertices scatter through their non-delta parts.
+  const Vertex* qs = s > 0 ? &L(s - 1) : nullptr;
+  const Vertex* qs_prev = s > 1 ? &L(s - 2) : nullptr;
+  const Vertex* pt = t > 0 ? &C(t - 1) : nullptr;
+  const Vertex* pt_prev = t > 1 ? &C(t - 2) : nullptr;
+  if (qs) mv[s - 1].delta = false;
+  if (pt) {
+    mv[s].delta = false;
+    mv[s].pdf_light = qs ? pdf_area(ctx, qs_prev, *qs, *pt) : pdf_light_origin(ctx, *pt, pt_prev ? *pt_prev : *pt);
+  }
+  if (pt_prev) mv[s + 1].pdf_light = qs ? pdf_area(ctx, qs, *pt, *pt_prev) : pdf_light_dir(*pt, *pt_prev);
+  if (qs) mv[s - 1].pdf_camera = pdf_area(ctx, pt_prev, *pt, *qs);
+  if (qs_prev) mv[s - 2].pdf_camera = pdf_area(ctx, pt, *qs, *qs_prev);
+  if (s == 1) mv[0].pdf_light = pdf_light_origin(ctx, *qs, *pt);
+
+  const Vertex& x0 = s > 0 ? L(0) : *pt;
+  const Vertex& x1 = s > 1 ? L(1) : (s == 1 ? *pt : *pt_prev);
+  MisPath path;
+  path.vertices = mv;
+  path.light_hittable = x0.light && !is_delta_light(x0.light->type());
+  path.nee_ratio = k >= 2 ? next_event_ratio(x0, x1) : 1.0;
+  strategy_density_ratios(path, s, ratios);
+  return mis_weight_from_ratios(ratios, s, ctx.config.heuristic);
+}
+
+Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t, PathSampler& ps,
+                   bool weighted) {
+  Connection c;
+  const Scene& scene = ctx.scene;
+  const Vertex& pt = camera[t - 1];
+  if (t > 1 && s != 0 && pt.kind == VertexKind::Light) return c;  // an escaped ray connects to nothing
+
+  auto finish = [&](const Vertex* light_end, const Vertex* camera_end) {
+    if (is_black(c.L)) return;
+    c.weight = weighted ? mis_weight(ctx, light, s, camera, t, light_end, camera_end) : 1.0;
+    c.weighted = c.L * static_cast<float>(c.weight);
+  };
+
+  if (s == 0) {
+    if (pt.kind == VertexKind::Light) {
+      // Each environment light is its own strategy family: weight it with its own densities.
+      for (const Light* env : scene.infinite_lights()) {
+        Rgb Le = env->Le(Ray{camera[t - 2].p, -pt.w_light});
+        if (is_black(Le)) continue;
+        Vertex end = pt;
+        end.light = env;
+        Rgb contribution = pt.beta * Le;
+        c.weight = weighted ? mis_weight(ctx, light, s, camera, t, nullptr, &end) : 1.0;
+        c.L += contribution;
+        c.weighted += contribution * static_cast<float>(c.weight);
+      }
+      return c;
+    }
+    if (!pt.light) return c;
+    c.L = pt.beta * pt.light->L(pt.p, pt.ng, pt.uv, direction_to(pt, camera[t - 2]));
+    finish(nullptr, nullptr);
+    return c;
+  }
+
+  if (t == 1) {
+    const Vertex& qs = light[s - 1];
+    if (!qs.connectible() || (qs.kind == VertexKind::Light && (!qs.light || qs.light->type() != LightType::Area)))
+      return c;
+    ps.seek(PathSampler::lens(s - 1));
+    std::optional<CameraWiSample> cw = scene.camera().sample_wi(qs.p, ps.get_2d());
+    if (!cw || !(cw->pdf > 0.f)) return c;
+    Vertex& cam = c.sampled;
+    cam.kind = VertexKind::Camera;
+    cam.p = cw->p_lens;
+    cam.beta = cw->We / cw->pdf;
+    {
+      float pdf_pos, pdf_dir;
+      scene.camera().pdf_we(Ray{cam.p, -cw->wi}, &pdf_pos, &pdf_dir);
+      cam.pdf_fwd = pdf_pos;
+    }
+    c.has_sampled = true;
+    if (qs.kind == VertexKind::Surface)
+      c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
+    else  // a point on an area light seen directly (light tracing's s = 1)
+      c.L = qs.beta * qs.light->L(qs.p, qs.ng, qs.uv, cw->wi) * std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
+    if (is_black(c.L) || scene.occluded(shadow_ray(qs, cam.p, Vec3(0.f)))) {
+      c.L = Rgb(0.f);
+      return c;
+    }
+    c.splat = true;
+    c.p_raster = cw->p_raster;
+    finish(nullptr, &cam);
+    return c;
+  }
+
+  if (s == 1) {
+    if (!pt.connectible()) return c;
+    ps.seek(PathSampler::next_event(t - 2));
+    float u_light = ps.get_1d();
+    Vec2 u = ps.get_2d();
+    std::optional<SampledLight> sl = ctx.lights.sample(u_light);
+    if (!sl || !(sl->pmf > 0.f)) return c;
+    std::optional<LightLiSample> ls = sl->light->sample_li(LightSampleContext{pt.p, pt.ng}, u);
+    if (!ls || !(ls->pdf > 0.f) || is_black(ls->L)) return c;
+    Vertex& lv = c.sampled;
+    lv.kind = VertexKind::Light;
+    lv.light = sl->light;
+    lv.p = ls->p_light;
+    lv.ng = ls->n_light;
+    lv.infinite = is_at_infinity(sl->light);
+    lv.w_light = -ls->wi;
+    lv.beta = ls->L / (ls->pdf * sl->pmf);
+    lv.mode = TransportMode::Importance;
+    lv.pdf_fwd = pdf_light_origin(ctx, lv, pt);
+    c.has_sampled = true;
+    c.L = pt.beta * pt.f(lv) * lv.beta * std::abs(glm::dot(ls->wi, pt.ns));
+    if (is_black(c.L) || scene.occluded(shadow_ray(pt, ls->p_light, ls->n_light))) {
+      c.L = Rgb(0.f);
+      return c;
+    }
+    finish(&lv, nullptr);
+    return c;
+  }
+
+  const Vertex& qs = light[s - 1];
+  if (!qs.connectible() || !pt.connectible()) return c;
+  c.L = qs.beta * qs.f(pt) * pt.f(qs) * pt.beta;
+  if (is_black(c.L)) return c;
+  Vec3 d = pt.p - qs.p;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) {
+    c.L = Rgb(0.f);
+    return c;
+  }
+  Vec3 w = d / std::sqrt(dist2);
+  c.L *= std::abs(glm::dot(qs.ns, w)) * std::abs(glm::dot(pt.ns, w)) / dist2;
+  if (is_black(c.L) || scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng))) {
+    c.L = Rgb(0.f);
+    return c;
+  }
+  finish(nullptr, nullptr);
+  return c;
+}
+
+}  // namespace penumbra::bdpt

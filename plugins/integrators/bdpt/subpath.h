@@ -1,0 +1,150 @@
+// Camera and light subpaths and their connections: the code that the "bdpt" and "lighttracing"
+// integrators share (and that tests/bdpt_test.cpp compiles directly to check the MIS weights).
+//
+// MIS formulation: pbrt-v3's explicit per-vertex densities. Every vertex stores the area density of
+// being generated from its own subpath's side (pdf_fwd) and from the other side (pdf_rev); a
+// connection patches the few densities it changes and hands the whole path to mis.h, which chains
+// the ratios p_i / p_s. Chosen over VCM's running partial sums because the next strategies to add
+// (probabilistic connections and hierarchical Russian roulette, issue 6) have densities that depend
+// on which eye vertex meets which light vertex (a cache lookup, a lobe-dependent acceptance
+// probability): with explicit densities the weight can evaluate such a factor for every edge of the
+// path at connection time, while partial sums would have to fold it in while the subpath is traced,
+// before its partner is known. The cost is O(path length) per connection, which is small next to
+// the shadow ray it comes with.
+//
+// Russian roulette is kept out of the MIS densities: the reverse density would need the roulette
+// probability the *other* subpath would have used, which depends on a throughput that does not
+// exist. Weights computed without it are still a partition of unity over the strategies that can
+// produce a path, and every such strategy still produces it with non-zero probability, so the
+// estimator stays unbiased; only the weights are slightly less than optimal for long paths.
+#pragma once
+
+#include "mis.h"
+
+#include <penumbra/bsdf.h>
+#include <penumbra/camera.h>
+#include <penumbra/light.h>
+#include <penumbra/sampler.h>
+#include <penumbra/scene.h>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace penumbra::bdpt {
+
+/// Light selection for emitted paths and next-event estimation (the MIS densities use the same pmf).
+class LightChooser {
+ public:
+  /// uniform: every light equally likely; otherwise the scene's power distribution.
+  LightChooser(const Scene& scene, bool uniform) : scene_(scene), uniform_(uniform) {}
+  std::optional<SampledLight> sample(float u) const;
+  float pmf(const Light* light) const;
+
+ private:
+  const Scene& scene_;
+  bool uniform_;
+};
+
+enum class VertexKind : uint8_t { Camera, Light, Surface };
+
+struct Vertex {
+  VertexKind kind = VertexKind::Surface;
+  Vec3 p{0.f};
+  Vec3 p_error{0.f};      // bound on the floating-point error of p (surfaces), for ray offsets
+  Vec3 ng{0.f}, ns{0.f};  // zero for points not on a surface (point lights, the lens)
+  Frame shading;
+  Vec2 uv{0.f};
+  Vec3 wo{0.f};           // surfaces: unit direction towards the previous vertex of the subpath
+  Vec3 w_light{0.f};      // vertices at infinity (environment, distant light): direction light travels
+  const Bsdf* bsdf = nullptr;
+  const Light* light = nullptr;  // light endpoints, and surfaces that emit
+  Rgb beta{0.f};          // subpath throughput up to and including this vertex's generation
+  float pdf_fwd = 0.f;    // area density from the previous vertex of this subpath
+  float pdf_rev = 0.f;    // area density from the next one, as if generated from the other end
+  bool delta = false;     // scattered specularly towards the next vertex
+  bool infinite = false;  // a direction rather than a point (escaped camera ray, environment, distant)
+  TransportMode mode = TransportMode::Radiance;
+
+  bool on_surface() const { return ng != Vec3(0.f); }
+  /// Whether a deterministic connection can end here (it needs a non-delta scattering or emission).
+  bool connectible() const;
+  /// BSDF towards `next` in this vertex's transport mode, with the adjoint shading-normal
+  /// correction on light paths; 0 when the shading and geometric normals disagree about the side.
+  Rgb f(const Vertex& next) const;
+};
+
+/// Unit direction from `from` towards `to` (towards the light for vertices at infinity).
+Vec3 direction_to(const Vertex& from, const Vertex& to);
+
+struct Config {
+  int max_depth = 5;  // bounces: strategies with s + t - 2 <= max_depth
+  int rr_depth = 3;   // bounces of a subpath before Russian roulette may end it
+  MisHeuristic heuristic = MisHeuristic::Power;
+};
+
+/// Sample dimensions at fixed offsets per purpose and depth, so that quasi-random samplers give
+/// each decision the same dimension whatever happened elsewhere on the paths.
+class PathSampler {
+ public:
+  PathSampler(Sampler& sampler, Point2i pixel, uint32_t index) : sampler_(sampler), pixel_(pixel), index_(index) {}
+  // Dimensions 0-3 are the film position and the lens, drawn by the render loop.
+  static constexpr uint32_t kLightChoice = 4, kLightPos = 5, kLightDir = 7, kLevels = 9, kPerLevel = 13;
+  static uint32_t camera_bounce(int level) { return kLevels + kPerLevel * level; }       // 4: lobe, dir, roulette
+  static uint32_t light_bounce(int level) { return kLevels + kPerLevel * level + 4; }    // 4
+  static uint32_t next_event(int level) { return kLevels + kPerLevel * level + 8; }      // 3: light, point
+  static uint32_t lens(int level) { return kLevels + kPerLevel * level + 11; }           // 2
+  void seek(uint32_t dim) { sampler_.start_pixel_sample(pixel_, index_, dim); }
+  float get_1d() { return sampler_.get_1d(); }
+  Vec2 get_2d() { return sampler_.get_2d(); }
+
+ private:
+  Sampler& sampler_;
+  Point2i pixel_;
+  uint32_t index_;
+};
+
+struct Context {
+  const Scene& scene;
+  const LightChooser& lights;
+  Config config;
+};
+
+/// Traces the camera subpath of `ray` into path[0 .. max_depth + 1]; returns the vertex count.
+int camera_subpath(const Context& ctx, const Ray& ray, PathSampler& ps, Vertex* path);
+/// Traces a light subpath into path[0 .. max_depth]; returns the vertex count (0: no light).
+int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path);
+
+struct Connection {
+  Rgb L{0.f};          // unweighted contribution
+  Rgb weighted{0.f};   // MIS-weighted contribution (what the image receives)
+  double weight = 0.0; // MIS weight (for several environment lights: the last one's)
+  bool splat = false;  // t = 1: lands at p_raster instead of the pixel being sampled
+  Vec2 p_raster{0.f};
+  Vertex sampled;      // the endpoint drawn for s = 1 (light) or t = 1 (camera)
+  bool has_sampled = false;
+};
+
+/// Evaluates strategy (s, t) on the given subpaths. weighted = false skips MIS (weight 1), for pure
+/// light tracing.
+Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t, PathSampler& ps,
+                   bool weighted = true);
+
+/// MIS weight of strategy (s, t); `light_end` / `camera_end` replace light[s-1] / camera[t-1] when
+/// the connection drew its own endpoint (or, for s = 0, names the environment light hit).
+double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
+                  const Vertex* light_end = nullptr, const Vertex* camera_end = nullptr);
+
+// Densities of single vertices, shared by the walks and the MIS weight.
+
+/// Area density with which `cur` (reached from `prev`, null for endpoints) generates `next`.
+float pdf_area(const Context& ctx, const Vertex* prev, const Vertex& cur, const Vertex& next);
+/// Density with which the emitter at `cur` sends light to `next` (area, or planar for infinite lights).
+float pdf_light_dir(const Vertex& cur, const Vertex& next);
+/// Density of choosing `cur` as the origin of an emitted path (selection pmf included).
+float pdf_light_origin(const Context& ctx, const Vertex& cur, const Vertex& next);
+/// p_nee(x0 | x1) / pdf_light_origin(x0): how much more likely next-event estimation from x1 is to
+/// pick x0 than emission sampling (1 unless x0 is on an area light).
+double next_event_ratio(const Vertex& x0, const Vertex& x1);
+
+}  // namespace penumbra::bdpt

@@ -1,0 +1,74 @@
+// Integrator "lighttracing": particle tracing from the lights alone, every vertex connected to the
+// lens and splatted (bdpt's t = 1 strategies, unweighted, sharing its code). Points on area lights
+// connect directly too, so emitters appear. What it cannot render: anything seen through a specular
+// chain from the camera, and environment lights seen directly (both need camera rays). For
+// debugging bdpt and for scenes dominated by caustics seen on diffuse surfaces.
+//
+// | parameter           | default | meaning                                     |
+// |---------------------|---------|---------------------------------------------|
+// | integer maxdepth    | 5       | longest path in bounces                      |
+// | integer rrdepth     | 3       | bounces before Russian roulette may end it  |
+// | string lightsampler | power   | light choice: power or uniform              |
+//
+// One light path per pixel sample: the image has as many light paths as a camera-ray render has
+// camera rays, and splats are divided by the samples per pixel.
+#include "../bdpt/render_loop.h"
+#include "../bdpt/subpath.h"
+
+#include <penumbra/plugin.h>
+
+namespace {
+
+using namespace penumbra;
+using namespace penumbra::bdpt;
+
+class LightTracingIntegrator final : public Integrator {
+ public:
+  LightTracingIntegrator(Config config, bool uniform_lights) : config_(config), uniform_lights_(uniform_lights) {}
+
+  void render(RenderContext& rc) override {
+    LightChooser chooser(rc.scene(), uniform_lights_);
+    Context ctx{rc.scene(), chooser, config_};
+    Vertex lens;  // connect() only looks at the camera endpoint's kind for t = 1
+    lens.kind = VertexKind::Camera;
+    render_with_splats(rc, [&](Point2i pixel, uint32_t index, const CameraSample&, Sampler& sampler, SampleOutputs& out) {
+      thread_local std::vector<Vertex> light_path;
+      light_path.resize(config_.max_depth + 1);
+      PathSampler ps(sampler, pixel, index);
+      int nl = light_subpath(ctx, ps, light_path.data());
+      for (int s = 1; s <= nl; ++s) {
+        Connection c = connect(ctx, light_path.data(), s, &lens, 1, ps, /*weighted=*/false);
+        if (c.splat && !is_black(c.L)) out.splats.push_back(Splat{c.p_raster, c.L});
+      }
+      return Rgb(0.f);
+    });
+  }
+
+ private:
+  Config config_;
+  bool uniform_lights_;
+};
+
+const ParamSpec kParams[] = {
+    {"integer", "maxdepth", "5", "longest path in bounces"},
+    {"integer", "rrdepth", "3", "bounces of a light path before Russian roulette may end it"},
+    {"string", "lightsampler", "power", "light selection: power or uniform"},
+};
+
+Object* create(const CreateContext& ctx) {
+  const ParamSet& p = ctx.params;
+  Config config;
+  config.max_depth = p.get_int("maxdepth");
+  if (config.max_depth < 0) throw Error(p.loc_of("maxdepth"), "maxdepth must be >= 0");
+  config.rr_depth = p.get_int("rrdepth");
+  if (config.rr_depth < 1) throw Error(p.loc_of("rrdepth"), "rrdepth must be >= 1");
+  std::string ls = p.get_string("lightsampler");
+  if (ls != "power" && ls != "uniform")
+    throw Error(p.loc_of("lightsampler"), "lightsampler '" + ls + "' is not supported; available: power, uniform");
+  return new LightTracingIntegrator(config, ls == "uniform");
+}
+
+}  // namespace
+
+PENUMBRA_PLUGIN(Integrator, "lighttracing", "light tracing: paths from the lights connected to the camera", kParams,
+                create)

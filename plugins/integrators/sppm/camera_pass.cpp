@@ -1,0 +1,145 @@
+// Camera paths for SPPM. Light that the camera side can estimate well is summed into Ld here: emitters
+// seen directly or through specular chains, and direct light at every non-specular vertex. Direct
+// light combines a light sample and a BSDF sample by MIS, as the path integrator does, but the BSDF
+// sample is traced here on its own, because the path stops at the visible point and never continues
+// in that direction. Light reaching a vertex after it was emitted and scattered is the photons' part.
+#include "camera_pass.h"
+
+#include <penumbra/sampling.h>
+
+namespace penumbra::sppm {
+
+namespace {
+
+// Shading and geometric normals must agree on whether wi is on wo's side (the path integrator's leak test).
+bool consistent_sides(const SurfaceInteraction& si, const Vec3& wo_local, const Vec3& wi_local, const Vec3& wi) {
+  bool reflect_shading = wi_local.z * wo_local.z > 0.f;
+  bool reflect_geometric = glm::dot(wi, si.ng) * glm::dot(si.wo, si.ng) > 0.f;
+  return reflect_shading == reflect_geometric;
+}
+
+struct DirectSamples {
+  float u_light;
+  Vec2 u_light_point;
+  float u_lobe;
+  Vec2 u_dir;
+};
+
+// Light sampling weighted against BSDF sampling, and BSDF sampling weighted against light sampling
+// (power heuristic); the BSDF ray counts any emitter it finds, whose light-sampling density is
+// pmf(light) * pdf_li, exactly as in the path integrator.
+Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
+                 const Scene& scene, const DirectSamples& u) {
+  Rgb L(0.f);
+  LightSampleContext lctx{si.p, si.ng};
+  if (std::optional<SampledLight> sl = scene.sample_light(u.u_light)) {
+    std::optional<LightLiSample> ls = sl->light->sample_li(lctx, u.u_light_point);
+    if (ls && ls->pdf > 0.f && !is_black(ls->L)) {
+      Vec3 wi = si.shading.to_local(ls->wi);
+      Rgb f = bsdf.f(wo, wi, sctx) * std::abs(wi.z);
+      if (!is_black(f) && consistent_sides(si, wo, wi, ls->wi) &&
+          !scene.occluded(spawn_ray_to(si.p, si.ng, ls->p_light, ls->n_light))) {
+        float light_pdf = sl->pmf * ls->pdf;
+        float w = is_delta_light(sl->light->type()) ? 1.f : power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
+        L += f * ls->L * w / light_pdf;
+      }
+    }
+  }
+
+  std::optional<BsdfSample> bs = bsdf.sample_f(wo, u.u_lobe, u.u_dir, sctx);
+  // A specular lobe cannot meet light sampling; the path continues through it instead (or, at a
+  // visible point, that lobe is not followed, as in pbrt).
+  if (!bs || bs->is_specular() || !(bs->pdf > 0.f) || is_black(bs->f)) return L;
+  Vec3 wi = si.shading.to_world(bs->wi);
+  if (!consistent_sides(si, wo, bs->wi, wi)) return L;
+  Rgb weight = bs->f * std::abs(bs->wi.z) / bs->pdf;
+  Ray ray = si.spawn_ray(wi);
+  if (std::optional<SurfaceInteraction> hit = scene.intersect(ray)) {
+    if (const Light* light = hit->area_light) {
+      Rgb Le = light->L(hit->p, hit->ng, hit->uv, hit->wo);
+      if (!is_black(Le)) {
+        float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, *hit);
+        L += weight * Le * power_heuristic(1, bs->pdf, 1, light_pdf);
+      }
+    }
+  } else {
+    SurfaceInteraction none;
+    for (const Light* light : scene.infinite_lights()) {
+      Rgb Le = light->Le(ray);
+      if (is_black(Le)) continue;
+      float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, none);
+      L += weight * Le * power_heuristic(1, bs->pdf, 1, light_pdf);
+    }
+  }
+  return L;
+}
+
+}  // namespace
+
+CameraPathResult trace_camera_path(const Scene& scene, const Film& film, Sampler& sampler, Point2i pixel,
+                                   uint32_t iteration, int max_depth) {
+  CameraPathResult out;
+  sampler.start_pixel_sample(pixel, iteration);
+  FilterSample fs = film.sample_filter(sampler.get_pixel_2d());
+  CameraSample cs{Vec2(pixel.x + 0.5f, pixel.y + 0.5f) + fs.offset, sampler.get_2d()};
+  std::optional<Ray> camera_ray = scene.camera().generate_ray(cs);
+  if (!camera_ray) return out;
+
+  Ray ray = *camera_ray;
+  // The filter's weight is left out: the film normalises pixel samples by their summed weights, and
+  // SPPM's single sample per pixel and iteration is drawn from the (non-negative) filter itself.
+  Rgb beta(1.f);
+  bool specular_bounce = false;
+  for (int depth = 0;; ++depth) {
+    std::optional<SurfaceInteraction> si = scene.intersect(ray);
+    // Emission counts here only where direct lighting could not have found it: on the camera ray
+    // and after specular bounces.
+    bool count_emission = depth == 0 || specular_bounce;
+    if (!si) {
+      if (count_emission)
+        for (const Light* light : scene.infinite_lights()) out.Ld += beta * light->Le(ray);
+      break;
+    }
+    if (si->area_light && count_emission) out.Ld += beta * si->area_light->L(si->p, si->ng, si->uv, si->wo);
+    if (depth == max_depth) break;
+
+    const Bsdf& bsdf = *si->bsdf;
+    uint32_t flags = bsdf.flags();
+    DirectSamples du{sampler.get_1d(), sampler.get_2d(), sampler.get_1d(), sampler.get_2d()};
+    float u_lobe = sampler.get_1d();
+    Vec2 u_dir = sampler.get_2d();
+    float u_rr = sampler.get_1d();
+    if (flags == 0) break;
+    Vec3 wo = si->shading.to_local(si->wo);
+    ShadingContext sctx{si->uv, TransportMode::Radiance};
+    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du);
+
+    // A diffuse surface keeps the point for the photons, unless no photon path could still fit
+    // within maxdepth (then direct light was all there was to add).
+    if (flags & BsdfDiffuse) {
+      if (depth + 1 < max_depth) {
+        out.vp = VisiblePoint{si->shading, wo, si->uv, &bsdf, beta, max_depth - 1 - depth};
+        out.p = si->p;
+      }
+      break;
+    }
+
+    // Specular and glossy surfaces pass the path on: photons are poor at narrow lobes.
+    std::optional<BsdfSample> bs = bsdf.sample_f(wo, u_lobe, u_dir, sctx);
+    if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
+    Vec3 wi = si->shading.to_world(bs->wi);
+    if (!consistent_sides(*si, wo, bs->wi, wi)) break;
+    beta *= bs->f * std::abs(bs->wi.z) / bs->pdf;
+    specular_bounce = bs->is_specular();
+    ray = si->spawn_ray(wi);
+    // Roulette only for dim paths: a visible point's throughput multiplies every photon it gathers.
+    float m = max_component(beta);
+    if (m < 0.25f) {
+      if (u_rr >= m) break;
+      beta /= m;
+    }
+  }
+  return out;
+}
+
+}  // namespace penumbra::sppm

@@ -1,0 +1,26 @@
+// The camera pass of SPPM: one path per pixel and iteration, followed through specular and glossy
+// bounces to the first diffuse surface, where it leaves a visible point for the photons.
+#pragma once
+
+#include "visible_point.h"
+
+#include <penumbra/camera.h>
+#include <penumbra/film.h>
+#include <penumbra/sampler.h>
+#include <penumbra/scene.h>
+
+namespace penumbra::sppm {
+
+struct CameraPathResult {
+  Rgb Ld{0.f};       // emission seen along the prefix plus direct light at its non-specular vertices
+  VisiblePoint vp;   // vp.bsdf == nullptr when the path found no diffuse surface
+  Vec3 p{0.f};       // the visible point's position
+};
+
+/// Traces sample `iteration` of `pixel`. Sampler dimensions: pixel 2, lens 2, then 10 per bounce
+/// (light 1 + 2, direct-light BSDF sample 1 + 2, continuation 1 + 2, roulette 1), drawn whether used
+/// or not so that quasi-random samplers keep their dimensions aligned across paths.
+CameraPathResult trace_camera_path(const Scene& scene, const Film& film, Sampler& sampler, Point2i pixel,
+                                   uint32_t iteration, int max_depth);
+
+}  // namespace penumbra::sppm
