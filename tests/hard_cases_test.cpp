@@ -222,3 +222,24 @@ TEST(HardCases, CheckerReportsTheFailuresItGuardsAgainst) {
   c.expected_mean = 2.0;
   EXPECT_NE(check_render(r, c).find("mean 1 instead of 2"), std::string::npos);
 }
+
+// Firefly guard: the stats count samples above the threshold, for every integrator, without
+// clamping them. A 1e9-radiance pinpoint light seen directly produces them; a dim scene does not.
+TEST(HardCases, FireflySamplesAreCountedPerIntegrator) {
+  std::string dir = temp_dir("hard-fireflies");
+  std::string hot = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 10 ]\n"
+                    "Film \"rgb\" \"integer xresolution\" [ 8 ] \"integer yresolution\" [ 8 ]\nWorldBegin\n"
+                    "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 1e9 1e9 1e9 ]\nShape \"sphere\" \"float radius\" [ 0.2 ]\nAttributeEnd\n";
+  for (const std::string& integrator : integrators()) {
+    RenderSettings s;
+    s.scene_file = write_file(dir, "hot.pbrt", hot);
+    s.integrator = integrator;
+    s.spp = 4;
+    s.quiet = true;
+    s.firefly_threshold = 1e6f;
+    RenderResult r = render(s);
+    if (integrator != "lighttracing") EXPECT_GT(r.stats.firefly_samples, 0u) << integrator;
+    s.firefly_threshold = 1e12f;
+    EXPECT_EQ(render(s).stats.firefly_samples, 0u) << integrator;
+  }
+}

@@ -48,6 +48,8 @@ int main(int argc, char** argv) {
   render->add_option("--res", res, "image resolution WIDTHxHEIGHT");
   render->add_option("--stats", settings.stats_file, "write render statistics as JSON");
   render->add_flag("-q,--quiet", settings.quiet, "no progress output");
+  render->add_option("--firefly-threshold", settings.firefly_threshold,
+                     "count samples whose largest component exceeds this (stats: firefly_samples)")->check(CLI::PositiveNumber);
   render->add_option("--aov", settings.aovs, "auxiliary outputs as EXR layers: albedo, normal, depth, samples, "
                      "variance, nonfinite, all")->delimiter(',');
   int spp_total = 0, spp_count = 0;

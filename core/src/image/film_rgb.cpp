@@ -114,6 +114,7 @@ FilmRgb::FilmRgb(Point2i resolution, PixelFilter filter, AovSet aovs)
 }
 
 void FilmRgb::add_sample(Point2i pixel, const Rgb& L, float weight) {
+  if (max_component(L) > firefly_threshold_) fireflies_.fetch_add(1, std::memory_order_relaxed);
   size_t i = static_cast<size_t>(pixel.y) * resolution_.x + pixel.x;
   Pixel& px = pixels_[i];
   for (int c = 0; c < 3; ++c) px.rgb[c] += static_cast<double>(weight) * L[c];
@@ -131,6 +132,7 @@ void FilmRgb::add_nonfinite(Point2i pixel) {
 }
 
 void FilmRgb::add_splat(const Vec2& p_raster, const Rgb& v) {
+  if (max_component(v) > firefly_threshold_) fireflies_.fetch_add(1, std::memory_order_relaxed);
   int x = static_cast<int>(std::floor(p_raster.x)), y = static_cast<int>(std::floor(p_raster.y));
   if (x < 0 || y < 0 || x >= resolution_.x || y >= resolution_.y) return;
   std::call_once(splat_once_, [&] {

@@ -56,6 +56,11 @@ class FilmRgb final : public Film {
   /// The image: weighted pixel means plus splats divided by `splat_spp`.
   ImageRgb image(double splat_spp) const;
   bool has_splats() const { return splats_ != nullptr; }
+  /// Firefly guard: samples and splats whose largest component exceeds `threshold` are counted
+  /// (not clamped: clamping would bias the image).
+  void set_firefly_threshold(float threshold) { firefly_threshold_ = threshold; }
+  float firefly_threshold() const { return firefly_threshold_; }
+  uint64_t firefly_count() const { return fireflies_.load(std::memory_order_relaxed); }
   /// The requested AOVs (empty when none were).
   AovSet aovs() const { return aovs_ ? aovs_->set() : AovSet{}; }
   std::vector<ImageLayer> aov_layers() const { return aovs_ ? aovs_->layers() : std::vector<ImageLayer>{}; }
@@ -70,6 +75,8 @@ class FilmRgb final : public Film {
   std::vector<Pixel> pixels_;
   std::unique_ptr<std::atomic<double>[]> splats_;  // allocated on the first splat
   std::once_flag splat_once_;
+  float firefly_threshold_ = Infinity;
+  std::atomic<uint64_t> fireflies_{0};
   std::unique_ptr<FilmAovs> aovs_;  // null unless AOVs were requested
 };
 

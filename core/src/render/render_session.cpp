@@ -140,6 +140,7 @@ RenderResult render(const RenderSettings& settings) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
 
   BuiltScene built = build_scene(desc, registry);
+  built.film->set_firefly_threshold(settings.firefly_threshold);
   RenderOptions options;
   options.time_budget = settings.time_budget;
   options.threads = threads;
@@ -173,6 +174,8 @@ RenderResult render(const RenderSettings& settings) {
   s.pixels = static_cast<uint64_t>(result.image.width) * result.image.height;
   s.rays = total_rays() - rays_before;
   s.nonfinite_samples = session.nonfinite();
+  s.firefly_samples = built.film->firefly_count();
+  s.firefly_threshold = settings.firefly_threshold;
   s.first_nonfinite_pixel = session.first_nonfinite();
   s.peak_memory_bytes = peak_memory_bytes();
   s.plugins_loaded = registry.loaded();
@@ -207,6 +210,8 @@ std::string stats_json(const RenderStats& s) {
   j["plugins_loaded"] = s.plugins_loaded;
   j["structures_built"] = s.structures_built;
   j["nonfinite_samples"] = s.nonfinite_samples;
+  j["firefly_samples"] = s.firefly_samples;
+  j["firefly_threshold"] = s.firefly_threshold;
   j["first_nonfinite_pixel"] = s.first_nonfinite_pixel
                                    ? nlohmann::json::array({s.first_nonfinite_pixel->first,
                                                             s.first_nonfinite_pixel->second})

@@ -26,6 +26,7 @@ struct RenderSettings {
   std::optional<std::pair<int, int>> resolution;  // --res WxH
   std::string stats_file;                // --stats FILE.json
   bool quiet = false;                    // no progress output
+  float firefly_threshold = 1000.f;      // samples brighter than this (max component) are counted
   std::vector<std::string> plugin_dirs;  // default: Registry::default_search_dirs()
   /// Snapshots for convergence studies: after the first complete pass at or past each of these
   /// render times (seconds, ascending), `on_snapshot` receives the current estimate. The time spent
@@ -47,6 +48,8 @@ struct RenderStats {
   uint64_t pixels = 0;
   uint64_t rays = 0;
   uint64_t nonfinite_samples = 0;
+  uint64_t firefly_samples = 0;          // samples or splats above firefly_threshold (kept, not clamped)
+  float firefly_threshold = 0.f;
   std::optional<std::pair<int, int>> first_nonfinite_pixel;
   uint64_t peak_memory_bytes = 0;
   std::vector<std::string> plugins_loaded;
