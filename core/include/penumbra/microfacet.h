@@ -13,6 +13,7 @@
 
 #include <penumbra/color.h>
 #include <penumbra/math.h>
+#include <penumbra/params.h>
 
 #include <complex>
 
@@ -174,6 +175,20 @@ inline bool refract(const Vec3& wi, Vec3 n, float eta, float* etap, Vec3* wt) {
   *wt = -wi / eta + (cos_i / eta - cos_t) * n;
   if (etap) *etap = eta;
   return true;
+}
+
+/// GGX alphas from pbrt-v4's roughness parameters: "float roughness", "float uroughness" and
+/// "float vroughness" (default: roughness), "bool remaproughness" (alpha = sqrt(roughness) when true).
+/// Negative roughness is an error at its parameter. Shared by every microfacet material.
+inline Vec2 microfacet_alphas(const ParamSet& p) {
+  for (const char* name : {"roughness", "uroughness", "vroughness"})
+    if (p.has(name) && !(p.get_float(name) >= 0.f)) throw Error(p.loc_of(name), std::string(name) + " must be >= 0");
+  float roughness = p.get_float("roughness");
+  Vec2 r(p.has("uroughness") ? p.get_float("uroughness") : roughness,
+         p.has("vroughness") ? p.get_float("vroughness") : roughness);
+  if (p.get_bool("remaproughness", true))
+    r = Vec2(TrowbridgeReitz::roughness_to_alpha(r.x), TrowbridgeReitz::roughness_to_alpha(r.y));
+  return r;
 }
 
 }  // namespace penumbra

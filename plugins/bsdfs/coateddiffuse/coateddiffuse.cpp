@@ -47,15 +47,8 @@ Object* create(const CreateContext& ctx) {
     throw Error(ps.loc_of("reflectance"), "reflectance must be in [0, 1] (energy would not be conserved)");
   float eta = ps.get_float("eta");
   if (!(eta > 0.f && std::isfinite(eta))) throw Error(ps.loc_of("eta"), "eta must be positive");
-  float roughness = ps.get_float("roughness");
-  float u = ps.has("uroughness") ? ps.get_float("uroughness") : roughness;
-  float v = ps.has("vroughness") ? ps.get_float("vroughness") : roughness;
-  if (!(u >= 0.f && v >= 0.f)) throw Error(ps.loc_of("roughness"), "roughness must be >= 0");
-  if (ps.get_bool("remaproughness")) {
-    u = TrowbridgeReitz::roughness_to_alpha(u);
-    v = TrowbridgeReitz::roughness_to_alpha(v);
-  }
-  float alpha = std::sqrt(u * v);  // GTR1 is isotropic: keep the lobe's area
+  Vec2 uv_alpha = microfacet_alphas(ps);
+  float alpha = std::sqrt(uv_alpha.x * uv_alpha.y);  // GTR1 is isotropic: keep the lobe's area
 
   warning(ctx.loc, "coateddiffuse is approximated by Disney's diffuse + clearcoat");
   disney::DisneyParams p;

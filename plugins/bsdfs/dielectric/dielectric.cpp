@@ -166,14 +166,8 @@ Object* create(const CreateContext& ctx) {
   const ParamSet& p = ctx.params;
   float eta = p.get_float("eta");
   if (!(eta > 0.f) || !std::isfinite(eta)) throw Error(p.loc_of("eta"), "eta must be a positive number");
-  float roughness = p.get_float("roughness");
-  float ur = p.get_float("uroughness", roughness), vr = p.get_float("vroughness", roughness);
-  for (const char* name : {"roughness", "uroughness", "vroughness"})
-    if (p.has(name) && !(p.get_float(name) >= 0.f)) throw Error(p.loc_of(name), std::string(name) + " must be >= 0");
-  if (p.get_bool("remaproughness")) {
-    ur = TrowbridgeReitz::roughness_to_alpha(ur);
-    vr = TrowbridgeReitz::roughness_to_alpha(vr);
-  }
+  Vec2 alpha = microfacet_alphas(p);
+  float ur = alpha.x, vr = alpha.y;
   return new DielectricBsdf(eta, TrowbridgeReitz(ur, vr));
 }
 
