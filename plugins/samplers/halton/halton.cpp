@@ -130,34 +130,23 @@ uint64_t wrap(int a, uint64_t m) {
   return static_cast<uint64_t>(r < 0 ? r + static_cast<int64_t>(m) : r);
 }
 
-class HaltonSampler final : public Sampler {
+class HaltonSampler final : public DimensionSampler {
  public:
   HaltonSampler(int spp, int seed, Randomization r) : spp_(spp), seed_(seed), randomization_(r) {}
 
   int samples_per_pixel() const override { return spp_; }
 
-  void start_pixel_sample(Point2i pixel, uint32_t index, uint32_t dimension) override {
+  void start(Point2i pixel, uint32_t index) override {
     uint64_t x = wrap(pixel.x, kScaleX), y = wrap(pixel.y, kScaleY);
     halton_index_ = first_index(x, y) + static_cast<uint64_t>(index) * kStride;
     pixel_key_ = hash_ints(static_cast<uint32_t>(pixel.x), static_cast<uint32_t>(pixel.y), static_cast<uint32_t>(seed_));
     index_ = index;
-    dim_ = dimension;
-  }
-
-  float get_1d() override { return sample(dim_++); }
-  Vec2 get_2d() override {
-    float x = sample(dim_++);
-    return Vec2(x, sample(dim_++));
-  }
-  Vec2 get_pixel_2d() override {
-    dim_ = std::max(dim_, 2u);
-    return Vec2(sample(0), sample(1));
   }
 
   std::unique_ptr<Sampler> clone() const override { return std::make_unique<HaltonSampler>(*this); }
 
  private:
-  float sample(uint32_t dim) const {
+  float value(uint32_t dim) const override {
     if (dim >= kPrimeCount) {
       uint64_t h = hash_ints(pixel_key_, index_, dim);
       return std::min(OneMinusEpsilon, static_cast<float>(h >> 40) * 0x1p-24f);
@@ -172,7 +161,7 @@ class HaltonSampler final : public Sampler {
   int spp_, seed_;
   Randomization randomization_;
   uint64_t halton_index_ = 0, pixel_key_ = 0;
-  uint32_t index_ = 0, dim_ = 0;
+  uint32_t index_ = 0;
 };
 
 const ParamSpec kParams[] = {

@@ -87,34 +87,22 @@ uint32_t owen_scramble(uint32_t v, uint64_t seed) {
 // to nearest could carry a value across an interval boundary, or up to 1).
 float to_unit_float(uint32_t bits) { return std::min(OneMinusEpsilon, static_cast<float>(bits >> 8) * 0x1p-24f); }
 
-class SobolSampler final : public Sampler {
+class SobolSampler final : public DimensionSampler {
  public:
   SobolSampler(int spp, int seed, Randomization r) : spp_(spp), seed_(seed), randomization_(r) {}
 
   int samples_per_pixel() const override { return spp_; }
 
-  void start_pixel_sample(Point2i pixel, uint32_t index, uint32_t dimension) override {
+  void start(Point2i pixel, uint32_t index) override {
     pixel_key_ = hash_ints(static_cast<uint32_t>(pixel.x), static_cast<uint32_t>(pixel.y),
                            static_cast<uint32_t>(seed_));
     index_ = index;
-    dim_ = dimension;
-  }
-
-  float get_1d() override { return sample(dim_++); }
-  Vec2 get_2d() override {
-    float x = sample(dim_++);
-    return Vec2(x, sample(dim_++));
-  }
-  // The pixel position always takes dimensions 0 and 1, the pair with t = 0.
-  Vec2 get_pixel_2d() override {
-    dim_ = std::max(dim_, 2u);
-    return Vec2(sample(0), sample(1));
   }
 
   std::unique_ptr<Sampler> clone() const override { return std::make_unique<SobolSampler>(*this); }
 
  private:
-  float sample(uint32_t dim) const {
+  float value(uint32_t dim) const override {
     // SplitMix-style: consecutive dimensions get unrelated scrambling keys.
     uint64_t key = mix_bits(pixel_key_ + (dim + 1ull) * 0x9e3779b97f4a7c15ull);
     if (dim >= kSobolDimensions) return to_unit_float(static_cast<uint32_t>(hash_ints(key, index_) >> 32));
@@ -131,7 +119,7 @@ class SobolSampler final : public Sampler {
   int spp_, seed_;
   Randomization randomization_;
   uint64_t pixel_key_ = 0;
-  uint32_t index_ = 0, dim_ = 0;
+  uint32_t index_ = 0;
 };
 
 const ParamSpec kParams[] = {
