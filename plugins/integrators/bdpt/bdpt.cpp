@@ -170,19 +170,13 @@ const ParamSpec kParams[] = {
 
 Object* create(const CreateContext& ctx) {
   const ParamSet& p = ctx.params;
-  Config config;
-  config.max_depth = p.get_int("maxdepth");
-  if (config.max_depth < 0) throw Error(p.loc_of("maxdepth"), "maxdepth must be >= 0");
-  config.rr_depth = p.get_int("rrdepth");
-  if (config.rr_depth < 1) throw Error(p.loc_of("rrdepth"), "rrdepth must be >= 1");
-  std::string ls = p.get_string("lightsampler");
-  if (ls != "power" && ls != "uniform")
-    throw Error(p.loc_of("lightsampler"), "lightsampler '" + ls + "' is not supported; available: power, uniform");
+  bool uniform_lights = false;
+  Config config = read_subpath_config(p, &uniform_lights);
   std::string h = p.get_string("misheuristic");
   if (h != "power" && h != "balance")
     throw Error(p.loc_of("misheuristic"), "misheuristic '" + h + "' is not supported; available: power, balance");
   config.heuristic = h == "power" ? MisHeuristic::Power : MisHeuristic::Balance;
-  return new BdptIntegrator(config, ls == "uniform", p.get_bool("visualizestrategies"), p.get_bool("visualizeweights"),
+  return new BdptIntegrator(config, uniform_lights, p.get_bool("visualizestrategies"), p.get_bool("visualizeweights"),
                             p.get_string("visualizeprefix"));
 }
 

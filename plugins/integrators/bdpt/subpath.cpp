@@ -432,4 +432,17 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
   return c;
 }
 
+Config read_subpath_config(const ParamSet& p, bool* uniform_lights) {
+  Config config;
+  config.max_depth = p.get_int("maxdepth");
+  if (config.max_depth < 0) throw Error(p.loc_of("maxdepth"), "maxdepth must be >= 0");
+  config.rr_depth = p.get_int("rrdepth");
+  if (config.rr_depth < 1) throw Error(p.loc_of("rrdepth"), "rrdepth must be >= 1");
+  std::string ls = p.get_string("lightsampler");
+  if (ls != "power" && ls != "uniform")
+    throw Error(p.loc_of("lightsampler"), "lightsampler '" + ls + "' is not supported; available: power, uniform");
+  *uniform_lights = ls == "uniform";
+  return config;
+}
+
 }  // namespace penumbra::bdpt

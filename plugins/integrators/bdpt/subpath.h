@@ -19,6 +19,8 @@
 // estimator stays unbiased; only the weights are slightly less than optimal for long paths.
 #pragma once
 
+#include <penumbra/params.h>
+
 #include "mis.h"
 
 #include <penumbra/bsdf.h>
@@ -82,6 +84,10 @@ struct Config {
   int rr_depth = 3;   // bounces of a subpath before Russian roulette may end it
   MisHeuristic heuristic = MisHeuristic::Power;
 };
+
+/// Reads and checks the parameters bdpt and lighttracing share: "maxdepth", "rrdepth" and
+/// "lightsampler" (power or uniform; `uniform_lights` is set for uniform). Throws located errors.
+Config read_subpath_config(const ParamSet& p, bool* uniform_lights);
 
 /// Sample dimensions at fixed offsets per purpose and depth, so that quasi-random samplers give
 /// each decision the same dimension whatever happened elsewhere on the paths.
