@@ -123,6 +123,22 @@ std::vector<std::string> integrators() {
   return r.available(PluginKind::Integrator);
 }
 
+// An integrator plugin with extra parameters: "bdpt+hrr+pc" is bdpt with its cached techniques on.
+struct Variant {
+  std::string label, plugin, params;
+};
+std::vector<Variant> variants() {
+  std::vector<Variant> out;
+  for (const std::string& name : integrators()) {
+    out.push_back({name, name, ""});
+    if (name == "bdpt") {
+      out.push_back({"bdpt+hrr", name, "\"bool hrr\" true"});
+      out.push_back({"bdpt+hrr+pc", name, "\"bool hrr\" true \"bool probconnect\" true \"integer pcrecords\" 16"});
+    }
+  }
+  return out;
+}
+
 // Failures of one render, as text (empty: it passed). The guards under test: discarding non-finite
 // samples before the film, and producing no negative radiance.
 std::string check_render(const RenderResult& r, const HardCase& c) {
@@ -141,12 +157,13 @@ std::string check_render(const RenderResult& r, const HardCase& c) {
   return problems;
 }
 
-RenderResult render_case(const HardCase& c, const std::string& dir, const std::string& integrator, const std::string& sampler,
+RenderResult render_case(const HardCase& c, const std::string& dir, const Variant& integrator, const std::string& sampler,
                          int spp = 16) {
   std::string scene = c.camera + "\nFilm \"rgb\" \"integer xresolution\" [ 16 ] \"integer yresolution\" [ 16 ]\nPixelFilter \"box\"\n"
-                      "Integrator \"" + integrator + "\" " + c.integrator_params + "\nWorldBegin\n" + c.world;
+                      "Integrator \"" + integrator.plugin + "\" " + c.integrator_params + " " + integrator.params +
+                      "\nWorldBegin\n" + c.world;
   RenderSettings s;
-  s.scene_file = write_file(dir, c.name + "-" + integrator + ".pbrt", scene);
+  s.scene_file = write_file(dir, c.name + "-" + integrator.label + ".pbrt", scene);
   s.sampler = sampler;
   s.spp = spp;
   s.seed = 7;
@@ -159,25 +176,26 @@ RenderResult render_case(const HardCase& c, const std::string& dir, const std::s
 TEST(HardCases, EveryIntegratorAndSamplerStaysFiniteAndCorrect) {
   std::string dir = temp_dir("hard");
   std::vector<HardCase> cases = hard_cases(dir);
-  std::vector<std::string> ints = integrators();
+  std::vector<Variant> ints = variants();
   ASSERT_FALSE(ints.empty());
   int renders = 0;
   for (const HardCase& c : cases)
-    for (const std::string& integrator : ints)
+    for (const Variant& integrator : ints)
       for (const char* sampler : {"independent", "halton", "sobol"}) {
         // Light tracing cannot see emitters directly and photon mapping is biased at low iteration
         // counts: their means are checked only where the case says nothing.
         HardCase checked = c;
-        if ((integrator == "lighttracing" || integrator == "sppm") && c.expected_mean > 0) checked.expected_mean = -1;
+        if ((integrator.plugin == "lighttracing" || integrator.plugin == "sppm") && c.expected_mean > 0)
+          checked.expected_mean = -1;
         RenderResult r;
         try {
           r = render_case(c, dir, integrator, sampler);
         } catch (const Error& e) {
-          ADD_FAILURE() << c.name << " / " << integrator << " / " << sampler << ": " << e.formatted();
+          ADD_FAILURE() << c.name << " / " << integrator.label << " / " << sampler << ": " << e.formatted();
           continue;
         }
         std::string problems = check_render(r, checked);
-        EXPECT_TRUE(problems.empty()) << c.name << " / " << integrator << " / " << sampler << ": " << problems;
+        EXPECT_TRUE(problems.empty()) << c.name << " / " << integrator.label << " / " << sampler << ": " << problems;
         ++renders;
       }
   std::printf("hard cases: %zu cases x %zu integrators x 3 samplers = %d renders\n", cases.size(), ints.size(), renders);
@@ -188,7 +206,7 @@ TEST(HardCases, EveryIntegratorAndSamplerStaysFiniteAndCorrect) {
 TEST(HardCases, FarAndTinyGeometryMatchesTheSceneNearTheOrigin) {
   std::string dir = temp_dir("hard-scale");
   // The same scene and camera, translated by (1e5, 1e5, -1e5) or scaled by 1e-4.
-  auto mean_of = [&](const HardCase& c) { return mean_luminance_free(render_case(c, dir, "path", "sobol", 1024).image); };
+  auto mean_of = [&](const HardCase& c) { return mean_luminance_free(render_case(c, dir, Variant{"path", "path", ""}, "sobol", 1024).image); };
   HardCase near{"scaled", sphere_with("Material \"diffuse\" \"rgb reflectance\" [ 0.7 0.7 0.7 ]")};
   near.camera = "LookAt 0 1 4  0 0.5 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 40 ]";
   double m0 = mean_of(near);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace penumbra {
@@ -13,6 +14,9 @@ class Object {
   /// "light_vertex_bvh"), reported in the render stats so tests can check that a scene builds only what
   /// it needs. Asked after preprocessing and again after rendering.
   virtual std::vector<std::string> structures_built() const { return {}; }
+  /// Figures worth reporting in the render stats' "integrator_stats" (e.g. connections per eye vertex,
+  /// build times), as (name, value) pairs. Asked after rendering.
+  virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
 };
 
 }  // namespace penumbra

@@ -9,7 +9,8 @@
 
 #ifndef PENUMBRA_SDK_VERSION
 // 2: PluginInfo gained the compiler identity after sdk_version.
-#define PENUMBRA_SDK_VERSION 2
+// 3: Object gained statistics() (a new virtual function changes every plugin class's vtable).
+#define PENUMBRA_SDK_VERSION 3
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

@@ -20,15 +20,36 @@
 // | bool visualizestrategies | false   | write each strategy's contribution, weighted and not   |
 // | bool visualizeweights    | false   | write each strategy's mean MIS weight                  |
 // | string visualizeprefix   | bdpt_   | path prefix of those images                            |
+// | bool connect             | true    | s, t >= 2 with the sample's own light subpath          |
+// | bool nextevent           | true    | s = 1 (next-event estimation)                          |
+// | bool lighttrace          | true    | t = 1 (light subpaths splatted through the lens)       |
+// | bool hrr                 | false   | hierarchical Russian roulette over a light-vertex cache|
+// | float hrrc               | 0       | HRR's C (area x sr); 0: calibrated to hrrconnections   |
+// | integer hrrconnections   | 32      | target mean HRR connections per eye vertex             |
+// | bool hrrcull             | true    | cull BVH nodes outside the acceptance range            |
+// | bool probconnect         | false   | probabilistic connections over the same cache          |
+// | integer probconnections  | 4       | draws per eye vertex (n_c)                             |
+// | integer pcrecords        | 100     | candidate light vertices per cache point               |
+// | integer lightpaths       | 0       | light paths per iteration (M); 0: the pixel count      |
+//
+// With hrr or probconnect, each pass renders one sample per pixel (an iteration): M light subpaths
+// are traced first into a cache (path j < pixel count is pixel j's own light subpath, reused), a BVH
+// is built over their vertices, and every non-specular camera vertex connects to cached vertices by
+// the cached techniques (connect_cached.h) besides its own strategies. All techniques share one MIS;
+// switching any of them off leaves the image the same in expectation as long as the others still
+// sample every path (emission hits, s = 0, are always on; without nextevent and lighttrace, paths
+// from delta lights are lost).
 //
 // The strategy images are <prefix>d<depth>_s<s>_t<t>.exr (weighted: they sum to the image when the
 // filter is a box), ..._unweighted.exr (each alone estimates the depth-d image, where the strategy can
 // sample it) and ..._weight.exr (mean weight over the samples the strategy found light with).
+#include "connect_cached.h"
 #include "render_loop.h"
 #include "subpath.h"
 
 #include <penumbra/image.h>
 #include <penumbra/plugin.h>
+#include <penumbra/rng.h>
 
 #include <fmt/core.h>
 
@@ -106,35 +127,65 @@ class StrategyImages {
   std::map<int, Buffers> buffers_;
 };
 
+// The cached techniques' own random streams follow the render's seed: the SDK does not hand the seed
+// to integrators, so it is read through the sampler (a few values at a sample index never rendered).
+uint64_t seed_of(const Sampler& proto) {
+  std::unique_ptr<Sampler> sampler = proto.clone();
+  sampler->start_pixel_sample(Point2i(0, 0), 0xfffffff0u, 0);
+  uint64_t h = 0x5eed;
+  for (int i = 0; i < 4; ++i) h = hash_ints(h, static_cast<uint64_t>(sampler->get_1d() * 0x1p32f));
+  return h;
+}
+
 class BdptIntegrator final : public Integrator {
  public:
-  BdptIntegrator(Config config, bool uniform_lights, bool vis_strategies, bool vis_weights, std::string prefix)
+  BdptIntegrator(Config config, bool uniform_lights, bool vis_strategies, bool vis_weights, std::string prefix,
+                 TechniqueSet techniques, CachedOptions cached)
       : config_(config), uniform_lights_(uniform_lights), vis_strategies_(vis_strategies),
-        vis_weights_(vis_weights), prefix_(std::move(prefix)) {}
+        vis_weights_(vis_weights), prefix_(std::move(prefix)), techniques_(techniques), cached_options_(cached) {}
 
   void render(RenderContext& rc) override {
     const Scene& scene = rc.scene();
     LightChooser chooser(scene, uniform_lights_);
-    Context ctx{scene, chooser, config_};
+    TechniqueSet techniques = techniques_;
+    std::unique_ptr<CachedConnector> cached;
+    if (cached_options_.hrr || cached_options_.probconnect) {
+      CachedOptions options = cached_options_;
+      options.seed = seed_of(rc.sampler());
+      cached = std::make_unique<CachedConnector>(options, config_.max_depth);
+      techniques.cached = cached.get();
+    }
+    Context ctx{scene, chooser, config_, techniques.all_regular() ? nullptr : &techniques};
     bool visualize = vis_strategies_ || vis_weights_;
-    StrategyImages images(rc.film().resolution(), config_.max_depth);
+    Point2i res = rc.film().resolution();
+    StrategyImages images(res, config_.max_depth);
     int max_depth = config_.max_depth;
+    if (cached) cached->prepare(ctx, rc.sampler(), res);
 
     auto sample = [&](Point2i pixel, uint32_t index, const CameraSample& cs, Sampler& sampler, SampleOutputs& out) {
-      thread_local std::vector<Vertex> camera_path, light_path;
+      thread_local std::vector<Vertex> camera_path, own_light_path;
       camera_path.resize(max_depth + 2);
-      light_path.resize(max_depth + 1);
+      own_light_path.resize(max_depth + 1);
       std::optional<Ray> ray = scene.camera().generate_ray(cs);
       if (!ray) return Rgb(0.f);
       PathSampler ps(sampler, pixel, index);
       int nc = camera_subpath(ctx, *ray, ps, camera_path.data());
-      int nl = light_subpath(ctx, ps, light_path.data());
+      // The pixel's light subpath: from the iteration's cache when it holds it (the same path).
+      size_t j = static_cast<size_t>(pixel.y) * res.x + pixel.x;
+      const Vertex* light_path = own_light_path.data();
+      int nl;
+      if (cached && j < cached->cache().path_count()) {
+        light_path = cached->cache().path(j);
+        nl = cached->cache().path_length(j);
+      } else {
+        nl = light_subpath(ctx, ps, own_light_path.data());
+      }
       Rgb L(0.f);
       for (int t = 1; t <= nc; ++t)
         for (int s = 0; s <= nl; ++s) {
           int depth = s + t - 2;
           if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
-          Connection c = connect(ctx, light_path.data(), s, camera_path.data(), t, ps);
+          Connection c = connect(ctx, light_path, s, camera_path.data(), t, ps);
           if (is_black(c.L)) continue;
           if (c.splat)
             out.splats.push_back(Splat{c.p_raster, c.weighted});
@@ -144,17 +195,39 @@ class BdptIntegrator final : public Integrator {
             out.tagged.push_back(TaggedSplat{StrategyImages::tag(s, t, max_depth), c.splat ? c.p_raster : cs.p_film,
                                              c.weighted, c.L, static_cast<float>(c.weight)});
         }
+      if (cached)
+        for (int t = 2; t <= nc; ++t)
+          cached->connect_eye_vertex(ctx, camera_path.data(), t, pixel, index,
+                                     [&](const Connection& c, int) { L += c.weighted; });
       return L;
     };
     auto commit = [&](const TaggedSplat& ts) { images.add(ts); };
-    int spp = render_with_splats(rc, sample, visualize ? TaggedCommitFn(commit) : TaggedCommitFn());
+    PassOptions passes;
+    if (cached) {
+      passes.one_sample_per_pass = true;
+      passes.before_pass = [&](uint32_t index) { cached->begin_iteration(ctx, rc.sampler(), res, index); };
+    }
+    int spp = render_with_splats(rc, sample, visualize ? TaggedCommitFn(commit) : TaggedCommitFn(), passes);
     if (visualize && spp > 0) images.write(prefix_, spp, vis_strategies_, vis_weights_);
+    if (cached) {
+      statistics_ = cached->statistics();
+      built_.push_back("light_vertex_cache");
+      if (cached_options_.hrr) built_.push_back("light_vertex_bvh");
+      if (cached_options_.probconnect) built_.push_back("connection_cache_points");
+    }
   }
+
+  std::vector<std::string> structures_built() const override { return built_; }
+  std::vector<std::pair<std::string, double>> statistics() const override { return statistics_; }
 
  private:
   Config config_;
   bool uniform_lights_, vis_strategies_, vis_weights_;
   std::string prefix_;
+  TechniqueSet techniques_;
+  CachedOptions cached_options_;
+  std::vector<std::string> built_;
+  std::vector<std::pair<std::string, double>> statistics_;
 };
 
 const ParamSpec kParams[] = {
@@ -166,6 +239,17 @@ const ParamSpec kParams[] = {
     {"bool", "visualizeweights", "false", "write each strategy's mean MIS weight"},
     {"string", "visualizeprefix", "bdpt_", "path prefix of the strategy images"},
     {"unsupported", "regularize", "", "path regularisation is not implemented"},
+    {"bool", "connect", "true", "connect camera vertices to the sample's own light subpath (s, t >= 2)"},
+    {"bool", "nextevent", "true", "next-event estimation (s = 1)"},
+    {"bool", "lighttrace", "true", "splat light subpaths through the lens (t = 1)"},
+    {"bool", "hrr", "false", "hierarchical Russian roulette connections to a light-vertex cache"},
+    {"float", "hrrc", "0", "HRR's C in P = min(C q / d^2, 1); 0: calibrate to hrrconnections"},
+    {"integer", "hrrconnections", "32", "target mean HRR connections per eye vertex (when hrrc is 0)"},
+    {"bool", "hrrcull", "true", "cull light-vertex BVH nodes outside the acceptance range"},
+    {"bool", "probconnect", "false", "probabilistic connections to the light-vertex cache"},
+    {"integer", "probconnections", "4", "probabilistic connections per eye vertex"},
+    {"integer", "pcrecords", "100", "candidate light vertices per cache point"},
+    {"integer", "lightpaths", "0", "light paths in the cache per iteration; 0: the pixel count"},
 };
 
 Object* create(const CreateContext& ctx) {
@@ -176,8 +260,29 @@ Object* create(const CreateContext& ctx) {
   if (h != "power" && h != "balance")
     throw Error(p.loc_of("misheuristic"), "misheuristic '" + h + "' is not supported; available: power, balance");
   config.heuristic = h == "power" ? MisHeuristic::Power : MisHeuristic::Balance;
+  TechniqueSet techniques;
+  techniques.connect = p.get_bool("connect");
+  techniques.nextevent = p.get_bool("nextevent");
+  techniques.lighttrace = p.get_bool("lighttrace");
+  CachedOptions cached;
+  cached.hrr = p.get_bool("hrr");
+  cached.hrr_c = p.get_float("hrrc");
+  if (!(cached.hrr_c >= 0.0) || !std::isfinite(cached.hrr_c))
+    throw Error(p.loc_of("hrrc"), "hrrc must be a finite number >= 0 (0: calibrate to hrrconnections)");
+  int target = p.get_int("hrrconnections");
+  if (target < 1) throw Error(p.loc_of("hrrconnections"), "hrrconnections must be >= 1");
+  cached.hrr_target = target;
+  cached.hrr_cull = p.get_bool("hrrcull");
+  cached.probconnect = p.get_bool("probconnect");
+  cached.pc_connections = p.get_int("probconnections");
+  if (cached.pc_connections < 1) throw Error(p.loc_of("probconnections"), "probconnections must be >= 1");
+  cached.pc_records = p.get_int("pcrecords");
+  if (cached.pc_records < 1) throw Error(p.loc_of("pcrecords"), "pcrecords must be >= 1");
+  int paths = p.get_int("lightpaths");
+  if (paths < 0) throw Error(p.loc_of("lightpaths"), "lightpaths must be >= 0 (0: the pixel count)");
+  cached.light_paths = static_cast<size_t>(paths);
   return new BdptIntegrator(config, uniform_lights, p.get_bool("visualizestrategies"), p.get_bool("visualizeweights"),
-                            p.get_string("visualizeprefix"));
+                            p.get_string("visualizeprefix"), techniques, cached);
 }
 
 }  // namespace

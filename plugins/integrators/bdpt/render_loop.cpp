@@ -21,7 +21,8 @@ struct TileResult {
 
 }  // namespace
 
-int render_with_splats(RenderContext& ctx, const PixelSampleFn& sample, const TaggedCommitFn& commit_tagged) {
+int render_with_splats(RenderContext& ctx, const PixelSampleFn& sample, const TaggedCommitFn& commit_tagged,
+                       const PassOptions& pass_options) {
   Film& film = ctx.film();
   const RenderOptions& opt = ctx.options();
   Point2i res = film.resolution();
@@ -36,6 +37,7 @@ int render_with_splats(RenderContext& ctx, const PixelSampleFn& sample, const Ta
   while (done_spp < opt.spp) {
     int begin = done_spp, end = std::min(opt.spp, done_spp + pass_spp);
     double pass_start = ctx.elapsed();
+    if (pass_options.before_pass) pass_options.before_pass(static_cast<uint32_t>(opt.first_sample + begin));
     int next_tile = 0;
 
     auto source = [&](tbb::flow_control& fc) -> std::shared_ptr<TileResult> {
@@ -99,7 +101,7 @@ int render_with_splats(RenderContext& ctx, const PixelSampleFn& sample, const Ta
     double now = ctx.elapsed();
     if (opt.time_budget > 0.0 && now >= opt.time_budget) break;
     // As in PixelIntegrator: short passes first, then longer ones, never much past a time budget.
-    pass_spp = std::min(pass_spp * 2, 16);
+    pass_spp = pass_options.one_sample_per_pass ? 1 : std::min(pass_spp * 2, 16);
     if (opt.time_budget > 0.0) {
       double per_spp = (now - pass_start) / (end - begin);
       if (per_spp > 0.0) pass_spp = std::clamp(static_cast<int>((opt.time_budget - now) / per_spp), 1, pass_spp);

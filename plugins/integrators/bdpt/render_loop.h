@@ -37,7 +37,15 @@ using PixelSampleFn = std::function<Rgb(Point2i pixel, uint32_t index, const Cam
 /// Receives tagged splats in a deterministic order (serially).
 using TaggedCommitFn = std::function<void(const TaggedSplat&)>;
 
+/// Integrators that share state across the pixel samples of one sample index (a light-vertex cache)
+/// render one sample per pixel per pass and prepare that state before each pass.
+struct PassOptions {
+  bool one_sample_per_pass = false;
+  std::function<void(uint32_t sample_index)> before_pass;  // called with the pass's sample index
+};
+
 /// Returns the samples per pixel completed (what the film divides splats by).
-int render_with_splats(RenderContext& ctx, const PixelSampleFn& sample, const TaggedCommitFn& commit_tagged = {});
+int render_with_splats(RenderContext& ctx, const PixelSampleFn& sample, const TaggedCommitFn& commit_tagged = {},
+                       const PassOptions& pass_options = {});
 
 }  // namespace penumbra::bdpt

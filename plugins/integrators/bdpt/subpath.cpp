@@ -128,6 +128,22 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
   return added;
 }
 
+// Unweighted contribution of joining light vertex qs and camera vertex pt (s, t >= 2) with a
+// shadow ray: both throughputs, both BSDFs and the geometry term; 0 when occluded.
+Rgb connect_vertices(const Scene& scene, const Vertex& qs, const Vertex& pt) {
+  if (!qs.connectible() || !pt.connectible() || pt.kind != VertexKind::Surface) return Rgb(0.f);
+  Rgb L = qs.beta * qs.f(pt) * pt.f(qs) * pt.beta;
+  if (is_black(L)) return L;
+  Vec3 d = pt.p - qs.p;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) return Rgb(0.f);
+  Vec3 w = d / std::sqrt(dist2);
+  L *= std::abs(glm::dot(qs.ns, w)) * std::abs(glm::dot(pt.ns, w)) / dist2;
+  if (is_black(L) || scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng)))
+    return Rgb(0.f);
+  return L;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -276,7 +292,7 @@ int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
 // ---------------------------------------------------------------------------------------------
 
 double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
-                  const Vertex* light_end, const Vertex* camera_end) {
+                  const Vertex* light_end, const Vertex* camera_end, Technique tau) {
   if (s + t == 2) return 1.0;
   int k = s + t - 1;
   auto L = [&](int i) -> const Vertex& { return (i == s - 1 && light_end) ? *light_end : light[i]; };
@@ -315,7 +331,36 @@ double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* 
   path.light_hittable = x0.light && !is_delta_light(x0.light->type());
   path.nee_ratio = k >= 2 ? next_event_ratio(x0, x1) : 1.0;
   strategy_density_ratios(path, s, ratios);
-  return mis_weight_from_ratios(ratios, s, ctx.config.heuristic);
+  if (!ctx.techniques || ctx.techniques->all_regular()) return mis_weight_from_ratios(ratios, s, ctx.config.heuristic);
+
+  // Several techniques per strategy: strategy i's sum is sum_tau c_tau(i)^beta (mis.h).
+  const TechniqueSet& ts = *ctx.techniques;
+  auto X = [&](int m) -> const Vertex& { return m < s ? L(m) : C(k - m); };
+  thread_local std::vector<double> sums;
+  sums.assign(k + 1, 0.0);
+  double own = 1.0;
+  for (int i = 0; i <= k; ++i) {
+    if (ratios[i] == 0.0) continue;
+    double sum = 0.0;
+    if (i == 0) {
+      sum = 1.0;
+    } else if (i == 1) {
+      sum = ts.nextevent ? 1.0 : 0.0;
+    } else if (i == k) {
+      sum = ts.lighttrace ? 1.0 : 0.0;
+    } else {
+      sum = ts.connect ? 1.0 : 0.0;
+      if (ts.cached)
+        for (Technique cached : {Technique::Hrr, Technique::ProbConnect}) {
+          if (!ts.cached->enabled(cached)) continue;
+          double c = ts.cached->factor(cached, X(i - 2), X(i - 1), X(i), X(i + 1));
+          sum += mis_power(c, ctx.config.heuristic);
+          if (i == s && cached == tau) own = c;
+        }
+    }
+    sums[i] = sum;
+  }
+  return mis_weight_from_ratios(ratios, s, ctx.config.heuristic, sums, own);
 }
 
 Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t, PathSampler& ps,
@@ -352,7 +397,9 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     return c;
   }
 
+  const TechniqueSet* ts = ctx.techniques;
   if (t == 1) {
+    if (ts && !ts->lighttrace) return c;
     const Vertex& qs = light[s - 1];
     if (!qs.connectible() || (qs.kind == VertexKind::Light && (!qs.light || qs.light->type() != LightType::Area)))
       return c;
@@ -384,7 +431,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
   }
 
   if (s == 1) {
-    if (!pt.connectible()) return c;
+    if ((ts && !ts->nextevent) || !pt.connectible()) return c;
     ps.seek(PathSampler::next_event(t - 2));
     float u_light = ps.get_1d();
     Vec2 u = ps.get_2d();
@@ -412,23 +459,21 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     return c;
   }
 
-  const Vertex& qs = light[s - 1];
-  if (!qs.connectible() || !pt.connectible()) return c;
-  c.L = qs.beta * qs.f(pt) * pt.f(qs) * pt.beta;
-  if (is_black(c.L)) return c;
-  Vec3 d = pt.p - qs.p;
-  float dist2 = glm::dot(d, d);
-  if (!(dist2 > 0.f)) {
-    c.L = Rgb(0.f);
-    return c;
-  }
-  Vec3 w = d / std::sqrt(dist2);
-  c.L *= std::abs(glm::dot(qs.ns, w)) * std::abs(glm::dot(pt.ns, w)) / dist2;
-  if (is_black(c.L) || scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng))) {
-    c.L = Rgb(0.f);
-    return c;
-  }
+  if (ts && !ts->connect) return c;
+  c.L = connect_vertices(scene, light[s - 1], pt);
   finish(nullptr, nullptr);
+  return c;
+}
+
+Connection connect_cached(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
+                          Technique tau, double factor) {
+  Connection c;
+  if (s < 2 || t < 2 || !(factor > 0.0)) return c;
+  c.L = connect_vertices(ctx.scene, light[s - 1], camera[t - 1]);
+  if (is_black(c.L)) return c;
+  c.L /= static_cast<float>(factor);
+  c.weight = mis_weight(ctx, light, s, camera, t, nullptr, nullptr, tau);
+  c.weighted = c.L * static_cast<float>(c.weight);
   return c;
 }
 

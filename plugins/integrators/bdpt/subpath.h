@@ -110,10 +110,38 @@ class PathSampler {
   uint32_t index_;
 };
 
+/// Connection techniques: every strategy (s, t) can be sampled by several techniques, each with a
+/// density c_tau * p_s where p_s is the strategy's path density (mis.h). The per-sample techniques have
+/// c = 1 (or 0 when switched off); the cached ones (hierarchical Russian roulette over a light-vertex
+/// cache, probabilistic connections) have a factor that depends on the edge they connect.
+enum class Technique : uint8_t { Regular, Hrr, ProbConnect };
+
+/// The factors of the cached techniques for an edge joining light-side vertex y (reached from y_prev on
+/// the light side) and eye-side vertex z (whose eye-side neighbour is z_next): c_HRR = M P(y, z),
+/// c_PC = n_c N_L P~(y | z). Must be a function of these four vertices only (never of the sample), so
+/// that the MIS weights of all techniques for one path sum to 1. Implemented in connect_cached.cpp.
+class CachedTechniques {
+ public:
+  virtual ~CachedTechniques() = default;
+  virtual double factor(Technique tau, const Vertex& y_prev, const Vertex& y, const Vertex& z,
+                        const Vertex& z_next) const = 0;
+  virtual bool enabled(Technique tau) const = 0;
+};
+
+/// Which techniques are on. Emission hits (s = 0) are always on.
+struct TechniqueSet {
+  bool connect = true;     // s >= 2, t >= 2 with the sample's own light subpath
+  bool nextevent = true;   // s = 1
+  bool lighttrace = true;  // t = 1
+  const CachedTechniques* cached = nullptr;
+  bool all_regular() const { return connect && nextevent && lighttrace && !cached; }
+};
+
 struct Context {
   const Scene& scene;
   const LightChooser& lights;
   Config config;
+  const TechniqueSet* techniques = nullptr;  // null: every per-sample technique, nothing cached
 };
 
 /// Traces the camera subpath of `ray` into path[0 .. max_depth + 1]; returns the vertex count.
@@ -132,14 +160,22 @@ struct Connection {
 };
 
 /// Evaluates strategy (s, t) on the given subpaths. weighted = false skips MIS (weight 1), for pure
-/// light tracing.
+/// light tracing. Techniques switched off in ctx.techniques give nothing.
 Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t, PathSampler& ps,
                    bool weighted = true);
 
-/// MIS weight of strategy (s, t); `light_end` / `camera_end` replace light[s-1] / camera[t-1] when
-/// the connection drew its own endpoint (or, for s = 0, names the environment light hit).
+/// A cached technique's connection of light vertex light[s-1] (s >= 2, from a cached light subpath)
+/// to camera vertex camera[t-1] (t >= 2): the regular connection divided by the technique's factor
+/// `factor` (M P or n_c N_L P_j, the true selection density), MIS-weighted as technique `tau`.
+Connection connect_cached(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
+                          Technique tau, double factor);
+
+/// MIS weight of strategy (s, t) sampled by technique `tau`; `light_end` / `camera_end` replace
+/// light[s-1] / camera[t-1] when the connection drew its own endpoint (or, for s = 0, names the
+/// environment light hit).
 double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
-                  const Vertex* light_end = nullptr, const Vertex* camera_end = nullptr);
+                  const Vertex* light_end = nullptr, const Vertex* camera_end = nullptr,
+                  Technique tau = Technique::Regular);
 
 // Densities of single vertices, shared by the walks and the MIS weight.
 

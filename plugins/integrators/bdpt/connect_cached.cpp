@@ -1,0 +1,276 @@
+#include "connect_cached.h"
+
+#include <penumbra/rng.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace penumbra::bdpt {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+uint64_t pixel_key(Point2i p) { return (static_cast<uint64_t>(static_cast<uint32_t>(p.y)) << 32) | static_cast<uint32_t>(p.x); }
+
+bool is_connectible_surface(const Vertex& v) { return v.kind == VertexKind::Surface && v.bsdf && v.connectible(); }
+
+// Pilot camera paths: one through the centre of every `stride`-th pixel in x and y, traced with an
+// independent stream. Returns their non-specular surface vertices and each one's eye-side neighbour.
+void pilot_eye_vertices(const Context& ctx, Point2i res, int stride, uint64_t seed, std::vector<Vertex>* eye,
+                        std::vector<Vertex>* eye_next) {
+  StreamSampler sampler(hash_ints(seed, 0x50494c4fu /* "PILO" */));
+  std::vector<Vertex> path(ctx.config.max_depth + 2);
+  for (int y = stride / 2; y < res.y; y += stride)
+    for (int x = stride / 2; x < res.x; x += stride) {
+      CameraSample cs{Vec2(x + 0.5f, y + 0.5f), Vec2(0.5f)};
+      std::optional<Ray> ray = ctx.scene.camera().generate_ray(cs);
+      if (!ray) continue;
+      PathSampler ps(sampler, Point2i(x, y), 0);
+      int n = camera_subpath(ctx, *ray, ps, path.data());
+      for (int t = 2; t <= n; ++t)
+        if (is_connectible_surface(path[t - 1])) {
+          eye->push_back(path[t - 1]);
+          eye_next->push_back(path[t - 2]);
+        }
+    }
+}
+
+}  // namespace
+
+CachedConnector::CachedConnector(const CachedOptions& options, int max_depth)
+    : opt_(options), max_depth_(max_depth), cache_(max_depth) {}
+
+CachedConnector::~CachedConnector() = default;
+
+bool CachedConnector::enabled(Technique tau) const {
+  switch (tau) {
+    case Technique::Hrr: return opt_.hrr;
+    case Technique::ProbConnect: return opt_.probconnect;
+    case Technique::Regular: return false;
+  }
+  return false;
+}
+
+SelLobe CachedConnector::eye_lobe(const Vertex& z, const Vertex& z_next) const {
+  SelLobe lobe;
+  lobe.z = z.p;
+  lobe.c = 0.0;
+  if (!is_connectible_surface(z)) return lobe;
+  Vec3 wo_world = direction_to(z, z_next);
+  Vec3 wo = z.shading.to_local(wo_world);
+  if (wo.z == 0.f) return lobe;
+  ShadingContext sc{z.uv, TransportMode::Radiance};
+  LobeSummary summary = z.bsdf->lobe(wo, sc);
+  float len = glm::length(summary.peak);
+  if (!(len > 0.f)) return lobe;
+  summary.peak /= len;
+  // The lobe's height is the BSDF times the cosine at its peak (only the peak's neighbourhood needs to
+  // be accurate: the other techniques cover the tails through MIS).
+  double c = luminance(z.bsdf->f(wo, summary.peak, sc)) * std::abs(summary.peak.z);
+  if (!(c > 0.0) || !std::isfinite(c)) return lobe;
+  // A BSDF without transmission is 0 on the far side of the surface: no connections there.
+  Vec3 half_space(0.f);
+  if (!(z.bsdf->flags() & BsdfTransmission)) half_space = glm::dot(z.ng, wo_world) >= 0.f ? z.ng : -z.ng;
+  return make_sel_lobe(z.p, z.shading, summary, c, half_space);
+}
+
+double CachedConnector::pc_weight(const Vertex& y_prev, const Vertex& y, int cp) const {
+  if (!is_connectible_surface(y)) return 0.0;
+  const CachePoint& point = pc_.point(cp);
+  Vec3 d = point.p - y.p;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) return 0.0;
+  Vec3 wi = d / std::sqrt(dist2);
+  Vec3 wo = direction_to(y, y_prev);
+  Rgb f = y.bsdf->f(y.shading.to_local(wo), y.shading.to_local(wi), ShadingContext{y.uv, TransportMode::Importance});
+  double w = luminance(f) * std::abs(glm::dot(y.ns, wi)) * std::abs(glm::dot(point.n, wi)) /
+             std::max(dist2, pc_radius_ * pc_radius_);
+  return std::isfinite(w) && w > 0.0 ? w : 0.0;
+}
+
+double CachedConnector::factor(Technique tau, const Vertex& y_prev, const Vertex& y, const Vertex& z,
+                               const Vertex& z_next) const {
+  if (!is_connectible_surface(y) || !is_connectible_surface(z)) return 0.0;
+  if (tau == Technique::Hrr && opt_.hrr) {
+    SelLobe lobe = eye_lobe(z, z_next);
+    if (!(lobe.c > 0.0)) return 0.0;
+    return static_cast<double>(M_) * hrr_acceptance(lobe, C_, y.p);
+  }
+  if (tau == Technique::ProbConnect && opt_.probconnect) {
+    int cp = pc_.lookup(z.p, z.ng);
+    if (cp < 0) return 0.0;
+    return opt_.pc_connections * static_cast<double>(M_) * pc_.approx_probability(cp, pc_weight(y_prev, y, cp));
+  }
+  return 0.0;
+}
+
+void CachedConnector::prepare(const Context& ctx, const Sampler& proto, Point2i resolution) {
+  auto t0 = std::chrono::steady_clock::now();
+  M_ = opt_.light_paths ? opt_.light_paths : static_cast<size_t>(resolution.x) * resolution.y;
+  // A pilot cache, independent of the render's samples.
+  StreamSampler pilot(hash_ints(opt_.seed, 0x50434143u /* "PCAC" */));
+  cache_.trace(ctx, pilot, resolution, 0xfffffffeu, M_, opt_.seed ^ 0x9e3779b97f4a7c15ull);
+  std::vector<Vertex> eye, eye_next;
+  pilot_eye_vertices(ctx, resolution, 4, opt_.seed, &eye, &eye_next);
+  if (opt_.hrr) calibrate(eye, eye_next);
+  if (opt_.probconnect) {
+    std::vector<CachePoint> points;
+    for (const Vertex& v : eye) points.push_back(CachePoint{v.p, v.ng});
+    // Cache points spread over the visible surfaces: about their spacing on a scene-sized area.
+    Bounds3 b = ctx.scene.bounds();
+    float diagonal = glm::length(b.max - b.min);
+    pc_radius_ = points.empty() ? 1.f : 2.f * diagonal / std::sqrt(static_cast<float>(points.size()));
+    if (!(pc_radius_ > 0.f) || !std::isfinite(pc_radius_)) pc_radius_ = 1.f;
+    pc_.build_points(std::move(points), pc_radius_, ConnectionCache::Options{opt_.pc_records, 0.2});
+    build_records(0xfffffffeu);
+    pc_.freeze_statistics();
+  }
+  calibration_seconds_ = seconds_since(t0);
+}
+
+void CachedConnector::calibrate(const std::vector<Vertex>& eye, const std::vector<Vertex>& eye_next) {
+  if (opt_.hrr_c > 0.0) {
+    C_ = opt_.hrr_c;
+    return;
+  }
+  // Mean accepted count per eye vertex S(C) = mean_z sum_y min(C q_z / d^2, 1), estimated on at most
+  // 128 pilot eye vertices and 2048 cache vertices, solved for S(C) = target by bisection on log C
+  // (S grows with C). Per-eye sums are added in a fixed order, so C does not depend on threads.
+  std::vector<SelLobe> lobes;
+  size_t step = std::max<size_t>(1, eye.size() / 128);
+  for (size_t i = 0; i < eye.size(); i += step) {
+    SelLobe l = eye_lobe(eye[i], eye_next[i]);
+    if (l.c > 0.0) lobes.push_back(l);
+  }
+  size_t V = cache_.vertex_count();
+  C_ = 1.0;
+  if (lobes.empty() || V == 0) return;
+  std::vector<Vec3> ys;
+  size_t vstep = std::max<size_t>(1, V / 2048);
+  for (size_t i = 0; i < V; i += vstep) ys.push_back(cache_.positions()[i]);
+  double scale = static_cast<double>(V) / ys.size();
+  std::vector<double> per_lobe(lobes.size());
+  auto mean_count = [&](double C) {
+    tbb::parallel_for(size_t(0), lobes.size(), [&](size_t i) {
+      HrrRange range(lobes[i], C);
+      double sum = 0.0;
+      for (const Vec3& y : ys) sum += range.acceptance(y);
+      per_lobe[i] = sum;
+    });
+    double total = 0.0;
+    for (double s : per_lobe) total += s;
+    return total * scale / lobes.size();
+  };
+  double target = std::min(opt_.hrr_target, static_cast<double>(V));
+  double lo = 1.0, hi = 1.0;
+  for (int i = 0; i < 200 && mean_count(lo) >= target; ++i) lo *= 0.01;
+  for (int i = 0; i < 200 && mean_count(hi) < target; ++i) hi *= 100.0;
+  for (int i = 0; i < 40; ++i) {
+    double mid = std::sqrt(lo * hi);
+    (mean_count(mid) < target ? lo : hi) = mid;
+  }
+  C_ = hi;
+}
+
+void CachedConnector::build_records(uint32_t index) {
+  pc_.build_records(cache_.vertex_count(), opt_.seed, index, [&](int cp, uint32_t v) {
+    LightCache::Ref r = cache_.ref(v);
+    const Vertex* path = cache_.path(r.path);
+    return pc_weight(path[r.vertex - 1], path[r.vertex], cp);
+  });
+}
+
+void CachedConnector::begin_iteration(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index) {
+  auto t0 = std::chrono::steady_clock::now();
+  cache_.trace(ctx, proto, resolution, index, M_, opt_.seed);
+  trace_seconds_ += seconds_since(t0);
+  ++iterations_;
+  cached_vertices_ += cache_.vertex_count();
+  if (opt_.hrr) {
+    auto t1 = std::chrono::steady_clock::now();
+    bvh_.build(cache_.positions());
+    build_seconds_ += seconds_since(t1);
+    bvh_bytes_ = bvh_.memory_bytes();
+    bvh_vertices_ = bvh_.vertex_count();
+  }
+  if (opt_.probconnect) build_records(index);
+}
+
+void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camera, int t, Point2i pixel,
+                                         uint32_t index,
+                                         const std::function<void(const Connection&, int s)>& emit) const {
+  const Vertex& z = camera[t - 1];
+  if (t < 2 || !is_connectible_surface(z)) return;
+  eye_vertices_.fetch_add(1, std::memory_order_relaxed);
+  if (opt_.hrr && bvh_.vertex_count() > 0) {
+    SelLobe lobe = eye_lobe(z, camera[t - 2]);
+    if (lobe.c > 0.0) {
+      HrrRandom rng{hash_ints(opt_.seed, pixel_key(pixel), index, static_cast<uint64_t>(t))};
+      HrrTraversalStats stats;
+      hrr_traverse(
+          bvh_, lobe, C_, rng,
+          [&](uint32_t v, double P, double) {
+            LightCache::Ref r = cache_.ref(v);
+            int s = static_cast<int>(r.vertex) + 1;
+            if (s + t - 2 > max_depth_) return;
+            Connection c = connect_cached(ctx, cache_.path(r.path), s, camera, t, Technique::Hrr,
+                                          static_cast<double>(M_) * P);
+            if (!is_black(c.L)) emit(c, s);
+          },
+          opt_.hrr_cull, &stats);
+      hrr_accepted_.fetch_add(stats.accepted, std::memory_order_relaxed);
+      hrr_nodes_.fetch_add(stats.nodes_visited, std::memory_order_relaxed);
+    }
+  }
+  if (opt_.probconnect && cache_.vertex_count() > 0) {
+    int cp = pc_.lookup(z.p, z.ng);
+    if (cp < 0) return;
+    Pcg32 rng(hash_ints(opt_.seed, pixel_key(pixel), index, static_cast<uint64_t>(t)), 0x50434f4eu /* "PCON" */);
+    for (int d = 0; d < opt_.pc_connections; ++d) {
+      std::optional<ConnectionCache::Pick> pick = pc_.sample(cp, rng.next_u32() * 0x1p-32);
+      if (!pick) break;
+      pc_draws_.fetch_add(1, std::memory_order_relaxed);
+      LightCache::Ref r = cache_.ref(pick->vertex);
+      int s = static_cast<int>(r.vertex) + 1;
+      if (s + t - 2 > max_depth_) continue;
+      double factor = opt_.pc_connections * static_cast<double>(M_) * pick->probability;
+      Connection c = connect_cached(ctx, cache_.path(r.path), s, camera, t, Technique::ProbConnect, factor);
+      if (!is_black(c.L)) emit(c, s);
+    }
+  }
+}
+
+std::vector<std::pair<std::string, double>> CachedConnector::statistics() const {
+  double eyes = std::max<double>(1.0, static_cast<double>(eye_vertices_.load()));
+  double iters = std::max<double>(1.0, static_cast<double>(iterations_));
+  std::vector<std::pair<std::string, double>> s = {
+      {"light_paths_per_iteration", static_cast<double>(M_)},
+      {"light_vertices_per_iteration", cached_vertices_ / iters},
+      {"light_cache_trace_seconds_per_iteration", trace_seconds_ / iters},
+      {"light_cache_bytes", static_cast<double>(cache_.memory_bytes())},
+      {"cached_eye_vertices", static_cast<double>(eye_vertices_.load())},
+      {"pilot_seconds", calibration_seconds_},
+  };
+  if (opt_.hrr) {
+    s.push_back({"hrr_c", C_});
+    s.push_back({"hrr_connections_per_eye_vertex", hrr_accepted_.load() / eyes});
+    s.push_back({"hrr_nodes_visited_per_eye_vertex", hrr_nodes_.load() / eyes});
+    s.push_back({"light_vertex_bvh_build_seconds", build_seconds_ / iters});
+    s.push_back({"light_vertex_bvh_bytes_per_vertex",
+                 bvh_vertices_ ? static_cast<double>(bvh_bytes_) / bvh_vertices_ : 0.0});
+  }
+  if (opt_.probconnect) {
+    s.push_back({"pc_cache_points", static_cast<double>(pc_.point_count())});
+    s.push_back({"pc_connections_per_eye_vertex", pc_draws_.load() / eyes});
+    s.push_back({"pc_bytes", static_cast<double>(pc_.memory_bytes())});
+  }
+  return s;
+}
+
+}  // namespace penumbra::bdpt
