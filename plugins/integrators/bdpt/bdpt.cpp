@@ -27,6 +27,7 @@
 // | float hrrc               | 0       | HRR's C (area x sr); 0: calibrated to hrrconnections   |
 // | integer hrrconnections   | 32      | target mean HRR connections per eye vertex             |
 // | bool hrrcull             | true    | cull BVH nodes outside the acceptance range            |
+// | float hrrmaxalpha        | 1       | HRR only at eye lobes with roughness alpha <= this     |
 // | bool probconnect         | false   | probabilistic connections over the same cache          |
 // | integer probconnections  | 4       | draws per eye vertex (n_c)                             |
 // | integer pcrecords        | 100     | candidate light vertices per cache point               |
@@ -246,6 +247,7 @@ const ParamSpec kParams[] = {
     {"float", "hrrc", "0", "HRR's C in P = min(C q / d^2, 1); 0: calibrate to hrrconnections"},
     {"integer", "hrrconnections", "32", "target mean HRR connections per eye vertex (when hrrc is 0)"},
     {"bool", "hrrcull", "true", "cull light-vertex BVH nodes outside the acceptance range"},
+    {"float", "hrrmaxalpha", "1", "HRR only at eye vertices whose lobe roughness alpha is at most this (1: all)"},
     {"bool", "probconnect", "false", "probabilistic connections to the light-vertex cache"},
     {"integer", "probconnections", "4", "probabilistic connections per eye vertex"},
     {"integer", "pcrecords", "100", "candidate light vertices per cache point"},
@@ -273,6 +275,8 @@ Object* create(const CreateContext& ctx) {
   if (target < 1) throw Error(p.loc_of("hrrconnections"), "hrrconnections must be >= 1");
   cached.hrr_target = target;
   cached.hrr_cull = p.get_bool("hrrcull");
+  cached.hrr_max_alpha = p.get_float("hrrmaxalpha");
+  if (!(cached.hrr_max_alpha > 0.0)) throw Error(p.loc_of("hrrmaxalpha"), "hrrmaxalpha must be > 0");
   cached.probconnect = p.get_bool("probconnect");
   cached.pc_connections = p.get_int("probconnections");
   if (cached.pc_connections < 1) throw Error(p.loc_of("probconnections"), "probconnections must be >= 1");

@@ -5,8 +5,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 namespace penumbra::bdpt {
 
@@ -17,6 +19,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 uint64_t pixel_key(Point2i p) { return (static_cast<uint64_t>(static_cast<uint32_t>(p.y)) << 32) | static_cast<uint32_t>(p.x); }
+
+std::atomic<uint64_t> next_connector_id{1};
 
 bool is_connectible_surface(const Vertex& v) { return v.kind == VertexKind::Surface && v.bsdf && v.connectible(); }
 
@@ -44,7 +48,7 @@ void pilot_eye_vertices(const Context& ctx, Point2i res, int stride, uint64_t se
 }  // namespace
 
 CachedConnector::CachedConnector(const CachedOptions& options, int max_depth)
-    : opt_(options), max_depth_(max_depth), cache_(max_depth) {}
+    : opt_(options), max_depth_(max_depth), id_(next_connector_id.fetch_add(1)), cache_(max_depth) {}
 
 CachedConnector::~CachedConnector() = default;
 
@@ -70,6 +74,9 @@ SelLobe CachedConnector::eye_lobe(const Vertex& z, const Vertex& z_next) const {
   float len = glm::length(summary.peak);
   if (!(len > 0.f)) return lobe;
   summary.peak /= len;
+  // Optionally only glossy eye vertices (a diffuse one's sphere of a range is costly to traverse and
+  // regular connections already serve it well); the MIS sees the same rule.
+  if (std::max(summary.alpha_x, summary.alpha_y) > opt_.hrr_max_alpha) return lobe;
   // The lobe's height is the BSDF times the cosine at its peak (only the peak's neighbourhood needs to
   // be accurate: the other techniques cover the tails through MIS).
   double c = luminance(z.bsdf->f(wo, summary.peak, sc)) * std::abs(summary.peak.z);
@@ -94,16 +101,62 @@ double CachedConnector::pc_weight(const Vertex& y_prev, const Vertex& y, int cp)
   return std::isfinite(w) && w > 0.0 ? w : 0.0;
 }
 
+namespace {
+
+// The MIS weight of every connection evaluates the factors of all the path's edges, and a pixel
+// sample's connections share most of their eye vertices: a small per-thread memo of the last eye
+// vertices' acceptance ranges and cache points saves recomputing them. Keyed by everything they
+// depend on (the connector, the vertex's position and BSDF, the eye-side neighbour's position).
+struct EyeMemo {
+  uint64_t owner = 0;
+  Vec3 z{0.f}, z_next{0.f}, n{0.f};
+  const Bsdf* bsdf = nullptr;
+  std::optional<HrrRange> range;  // empty: HRR does not apply at z
+  int cache_point = -1;
+  bool has_range = false, has_cache_point = false;
+};
+
+EyeMemo& eye_memo(uint64_t owner, const Vertex& z, const Vertex& z_next) {
+  thread_local std::array<EyeMemo, 64> memo;
+  auto bits = [](float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+  };
+  uint64_t h = hash_ints(owner, bits(z.p.x) ^ (uint64_t(bits(z.p.y)) << 32), bits(z.p.z) ^ (uint64_t(bits(z_next.p.x)) << 32),
+                         bits(z_next.p.y) ^ (uint64_t(bits(z_next.p.z)) << 32));
+  EyeMemo& m = memo[h & 63];
+  if (m.owner != owner || m.z != z.p || m.z_next != z_next.p || m.bsdf != z.bsdf || m.n != z.ng) {
+    m = EyeMemo{};
+    m.owner = owner;
+    m.z = z.p;
+    m.z_next = z_next.p;
+    m.n = z.ng;
+    m.bsdf = z.bsdf;
+  }
+  return m;
+}
+
+}  // namespace
+
 double CachedConnector::factor(Technique tau, const Vertex& y_prev, const Vertex& y, const Vertex& z,
                                const Vertex& z_next) const {
   if (!is_connectible_surface(y) || !is_connectible_surface(z)) return 0.0;
+  EyeMemo& memo = eye_memo(id_, z, z_next);
   if (tau == Technique::Hrr && opt_.hrr) {
-    SelLobe lobe = eye_lobe(z, z_next);
-    if (!(lobe.c > 0.0)) return 0.0;
-    return static_cast<double>(M_) * hrr_acceptance(lobe, C_, y.p);
+    if (!memo.has_range) {
+      SelLobe lobe = eye_lobe(z, z_next);
+      if (lobe.c > 0.0) memo.range.emplace(lobe, C_);
+      memo.has_range = true;
+    }
+    return memo.range ? static_cast<double>(M_) * memo.range->acceptance(y.p) : 0.0;
   }
   if (tau == Technique::ProbConnect && opt_.probconnect) {
-    int cp = pc_.lookup(z.p, z.ng);
+    if (!memo.has_cache_point) {
+      memo.cache_point = pc_.lookup(z.p, z.ng);
+      memo.has_cache_point = true;
+    }
+    int cp = memo.cache_point;
     if (cp < 0) return 0.0;
     return opt_.pc_connections * static_cast<double>(M_) * pc_.approx_probability(cp, pc_weight(y_prev, y, cp));
   }

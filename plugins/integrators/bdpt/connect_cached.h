@@ -31,6 +31,7 @@ struct CachedOptions {
   double hrr_c = 0.0;          // C; 0: calibrate to hrr_target connections per eye vertex
   double hrr_target = 32.0;
   bool hrr_cull = true;
+  double hrr_max_alpha = 1.0;  // HRR only at eye vertices whose lobe has max(alpha) <= this
   bool probconnect = false;
   int pc_connections = 4;      // n_c
   int pc_records = 100;        // R
@@ -77,6 +78,7 @@ class CachedConnector final : public CachedTechniques {
 
   CachedOptions opt_;
   int max_depth_;
+  uint64_t id_;  // unique per connector (keys per-thread memos)
   size_t M_ = 0;
   double C_ = 0.0;
   LightCache cache_;
