@@ -29,15 +29,12 @@ struct Row {
   ImageErrors errors;
 };
 
-std::string config_name(const std::pair<std::string, std::string>& c) {
-  return c.second.empty() ? c.first : c.first + ":" + c.second;
-}
-
-RenderSettings base_settings(const ConvergeSettings& s, const std::pair<std::string, std::string>& config, uint32_t seed) {
+RenderSettings base_settings(const ConvergeSettings& s, const ConvergeConfig& config, uint32_t seed) {
   RenderSettings r;
   r.scene_file = s.scene;
-  r.integrator = config.first;
-  r.sampler = config.second;
+  r.integrator = config.integrator;
+  r.sampler = config.sampler;
+  r.integrator_params = config.params;
   r.seed = seed;
   r.resolution = s.resolution;
   r.threads = s.threads;
@@ -48,7 +45,7 @@ RenderSettings base_settings(const ConvergeSettings& s, const std::pair<std::str
 // Two independent half-length renders: their mean is the reference, and their difference estimates
 // the reference's own variance, which is subtracted from every measured squared error.
 void make_reference(const ConvergeSettings& s, ImageRgb* reference, ImageRgb* variance) {
-  auto config = parse_configs(s.reference_config).at(0);
+  ConvergeConfig config = parse_configs(s.reference_config, "--reference-config").at(0);
   ImageRgb halves[2];
   for (int h = 0; h < 2; ++h) {
     RenderSettings r = base_settings(s, config, 1000001u + h);
@@ -76,28 +73,52 @@ double time_to_reach(const std::vector<std::pair<double, double>>& curve, double
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> parse_configs(const std::string& text) {
-  std::vector<std::pair<std::string, std::string>> out;
+std::vector<ConvergeConfig> parse_configs(const std::string& text, const std::string& option) {
+  std::vector<ConvergeConfig> out;
   size_t start = 0;
   while (start <= text.size()) {
     size_t end = text.find(',', start);
     if (end == std::string::npos) end = text.size();
     std::string item = text.substr(start, end - start);
     if (!item.empty()) {
+      ConvergeConfig c;
+      c.name = item;
+      // integrator[/NAME=VALUE...][:sampler]: the sampler follows the first ':'.
       size_t colon = item.find(':');
-      out.emplace_back(item.substr(0, colon), colon == std::string::npos ? "" : item.substr(colon + 1));
-      if (out.back().first.empty()) throw Error(fmt::format("--configs: '{}' names no integrator", item));
+      std::string head = item.substr(0, colon);
+      c.sampler = colon == std::string::npos ? "" : item.substr(colon + 1);
+      size_t slash = head.find('/');
+      c.integrator = head.substr(0, slash);
+      if (c.integrator.empty()) throw Error(fmt::format("{}: '{}' names no integrator", option, item));
+      std::string where = fmt::format("{} '{}'", option, item);
+      while (slash != std::string::npos) {
+        size_t next = head.find('/', slash + 1);
+        std::string text = head.substr(slash + 1, next == std::string::npos ? std::string::npos : next - slash - 1);
+        ParamOverride o = parse_param_override(text, where);
+        o.origin = fmt::format("{}: {}", where, text);  // "--configs 'bdpt/maxdepth=x:sobol': maxdepth=x"
+        c.params.push_back(std::move(o));
+        slash = next;
+      }
+      for (const ConvergeConfig& other : out)
+        if (other.name == c.name) throw Error(fmt::format("{}: '{}' is given twice", option, item));
+      out.push_back(std::move(c));
     }
     start = end + 1;
   }
-  if (out.empty()) throw Error("--configs: give at least one integrator[:sampler]");
+  if (out.empty()) throw Error(fmt::format("{}: give at least one integrator[/NAME=VALUE...][:sampler]", option));
   return out;
 }
 
 int run_converge(const ConvergeSettings& s) {
-  if (s.configs.empty()) throw Error("--configs: give at least one integrator[:sampler]");
+  if (s.configs.empty()) throw Error("--configs: give at least one integrator[/NAME=VALUE...][:sampler]");
   if (s.runs < 1) throw Error("--runs must be at least 1");
   if (s.snapshots < 2) throw Error("--snapshots must be at least 2");
+  // Parameter overrides are checked against the integrators' tables before any long render.
+  for (const ConvergeConfig& c : s.configs) check_param_overrides(c.integrator, c.params);
+  if (s.make_reference > 0.0) {
+    ConvergeConfig ref = parse_configs(s.reference_config, "--reference-config").at(0);
+    check_param_overrides(ref.integrator, ref.params);
+  }
   fs::create_directories(s.out_dir);
 
   ImageRgb reference, variance;
@@ -128,9 +149,9 @@ int run_converge(const ConvergeSettings& s) {
       int snapshot = 0;
       r.on_snapshot = [&](double seconds, int spp, const ImageRgb& img) {
         ImageErrors e = image_errors(img, reference, have_variance ? &variance : nullptr);
-        rows.push_back(Row{config_name(config), run, snapshot++, seconds, spp, e});
+        rows.push_back(Row{config.name, run, snapshot++, seconds, spp, e});
       };
-      std::fprintf(stderr, "converge: %s run %d/%d (%.0f s)\n", config_name(config).c_str(), run + 1, s.runs, s.time);
+      std::fprintf(stderr, "converge: %s run %d/%d (%.0f s)\n", config.name.c_str(), run + 1, s.runs, s.time);
       render(r);
     }
   }
@@ -153,7 +174,7 @@ int run_converge(const ConvergeSettings& s) {
   std::map<std::string, std::vector<std::pair<double, double>>> curves;
   double common_target = 0.0;
   for (const auto& config : s.configs) {
-    std::string name = config_name(config);
+    std::string name = config.name;
     nlohmann::json points = nlohmann::json::array();
     for (int k = 0; k < s.snapshots; ++k) {
       double t = 0, spp = 0, rmse = 0, rel = 0, mae = 0, rel_min = 1e300, rel_max = -1e300;

@@ -44,6 +44,10 @@ int main(int argc, char** argv) {
   render->add_option("--threads", settings.threads, "worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   auto* seed_opt = render->add_option("--seed", seed, "sampler seed");
   render->add_option("--integrator", settings.integrator, "integrator plugin to use instead of the scene's");
+  std::vector<std::string> params;
+  render->add_option("--param", params, "NAME=VALUE: set an integrator parameter, typed by the integrator's table "
+                     "(after --integrator; repeatable), e.g. --param maxdepth=8")
+      ->allow_extra_args(false);
   render->add_option("--sampler", settings.sampler, "sampler plugin to use instead of the scene's");
   render->add_option("--res", res, "image resolution WIDTHxHEIGHT");
   render->add_option("--stats", settings.stats_file, "write render statistics as JSON");
@@ -61,10 +65,11 @@ int main(int argc, char** argv) {
   std::string conv_configs, conv_res;
   auto* converge = app.add_subcommand("converge", "Measure error versus time of integrator:sampler configurations");
   converge->add_option("scene", conv.scene, "pbrt-v4 scene file")->required()->check(CLI::ExistingFile);
-  converge->add_option("--configs", conv_configs, "comma-separated integrator[:sampler] list, e.g. path:sobol,bdpt:sobol")->required();
+  converge->add_option("--configs", conv_configs, "comma-separated integrator[/NAME=VALUE...][:sampler] list, e.g. "
+                       "path:sobol,bdpt/maxdepth=8:sobol; NAME=VALUE sets an integrator parameter as --param does")->required();
   converge->add_option("--reference", conv.reference, "reference image (EXR); reference-variance.exr beside it is used if present")->check(CLI::ExistingFile);
   converge->add_option("--make-reference", conv.make_reference, "render a reference for this many seconds (two halves)")->check(CLI::PositiveNumber);
-  converge->add_option("--reference-config", conv.reference_config, "integrator[:sampler] for --make-reference");
+  converge->add_option("--reference-config", conv.reference_config, "integrator[/NAME=VALUE...][:sampler] for --make-reference");
   converge->add_option("--time", conv.time, "time budget per run, seconds")->check(CLI::PositiveNumber);
   converge->add_option("--runs", conv.runs, "independent runs per configuration")->check(CLI::Range(1, 1000));
   converge->add_option("--snapshots", conv.snapshots, "log-spaced snapshots per run")->check(CLI::Range(2, 64));
@@ -109,6 +114,7 @@ int main(int argc, char** argv) {
     if (*total_opt) settings.spp_total = spp_total;
     if (*count_opt) settings.spp_count = spp_count;
     if (!res.empty()) settings.resolution = parse_resolution(res);
+    for (const std::string& p : params) settings.integrator_params.push_back(penumbra::parse_param_override(p));
     return penumbra::cli::run_render(settings);
   } catch (const penumbra::Error& e) {
     std::fprintf(stderr, "%s\n", e.formatted().c_str());

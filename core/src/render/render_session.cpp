@@ -18,9 +18,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
+#include <charconv>
 #include <chrono>
 #include <climits>
+#include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <mutex>
 
 namespace penumbra {
@@ -110,7 +115,157 @@ void override_plugin(SceneEntity& entity, PluginKind kind, const std::string& na
   entity.params = std::move(kept);
 }
 
+std::string trim(const std::string& s) {
+  size_t b = 0, e = s.size();
+  while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
+  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
+  return s.substr(b, e - b);
+}
+
+// Whole-text integer and float parsing (no trailing characters, finite).
+bool parse_integer(const std::string& text, double* out) {
+  long long v = 0;
+  const char* first = text.data() + (!text.empty() && text[0] == '+' ? 1 : 0);
+  const char* last = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ec != std::errc() || ptr != last || first == last || v < INT_MIN || v > INT_MAX) return false;
+  *out = static_cast<double>(v);
+  return true;
+}
+
+bool parse_float(const std::string& text, double* out) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  double v = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size() || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+// Numbers of a multi-component value: "0.5 0.5 0.5" or "0.5,0.5,0.5".
+std::vector<std::string> split_numbers(const std::string& text) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : text) {
+    if (c == ',' || std::isspace(static_cast<unsigned char>(c))) {
+      if (!cur.empty()) out.push_back(cur), cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+int type_components(const std::string& base) {
+  if (base == "rgb" || base == "point3" || base == "vector3" || base == "normal") return 3;
+  if (base == "point2" || base == "vector2") return 2;
+  return 1;
+}
+
+// The Param an override sets, typed by the plugin's declaration `spec`. Errors start with the origin.
+Param typed_param(const ParamSpec& spec, const ParamOverride& o, const std::string& what) {
+  auto fail = [&](const std::string& msg) { return Error(fmt::format("{}: {}", o.origin, msg)); };
+  std::string type = spec.type;
+  bool array = type.size() > 2 && type.compare(type.size() - 2, 2, "[]") == 0;
+  std::string base = array ? type.substr(0, type.size() - 2) : type;
+  Param p{base, o.name, {}, {}, {}, {}};
+  // Plugins locate their own value errors ("maxdepth must be >= 0") with loc_of(name); this
+  // location lets render() recognise those and name the override instead of a file.
+  p.loc.filename = std::make_shared<const std::string>(o.origin);
+  std::string value = base == "string" ? o.value : trim(o.value);
+  if (base == "string") {
+    p.strings.push_back(value);
+  } else if (base == "bool") {
+    std::string v = value;
+    std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (v != "true" && v != "false") throw fail(fmt::format("'{}' is not a bool (true or false)", o.value));
+    p.bools.push_back(v == "true");
+  } else if (base == "integer" || base == "float" || type_components(base) > 1) {
+    std::vector<std::string> words = split_numbers(value);
+    size_t k = static_cast<size_t>(type_components(base));
+    if (!array && k == 1 && words.size() != 1) {
+      throw fail(fmt::format("'{}' is not {}", o.value, base == "integer" ? "an integer" : "a float"));
+    }
+    if (!array && words.size() != k)
+      throw fail(fmt::format("parameter '{}' of {} is of type {} and takes {} numbers (e.g. {}=0.5,0.5,0.5), got {}",
+                             o.name, what, base, k, o.name, words.size()));
+    if (array && (words.empty() || words.size() % k != 0))
+      throw fail(fmt::format("parameter '{}' of {} is of type {} and takes a multiple of {} numbers, got {}",
+                             o.name, what, type, k, words.size()));
+    for (const std::string& w : words) {
+      double v = 0;
+      bool ok = base == "integer" ? parse_integer(w, &v) : parse_float(w, &v);
+      if (!ok) throw fail(fmt::format("'{}' is not {}", w, base == "integer" ? "an integer" : "a float"));
+      p.numbers.push_back(v);
+    }
+  } else {
+    throw fail(fmt::format("parameter '{}' of {} has type '{}', which cannot be set on the command line",
+                           o.name, what, type));
+  }
+  return p;
+}
+
 }  // namespace
+
+ParamOverride parse_param_override(const std::string& text, const std::string& option) {
+  ParamOverride o;
+  o.origin = fmt::format("{} {}", option, text);
+  size_t eq = text.find('=');
+  if (eq == std::string::npos)
+    throw Error(fmt::format("{}: expected NAME=VALUE (e.g. maxdepth=8), got '{}'", option, text));
+  o.name = trim(text.substr(0, eq));
+  o.value = text.substr(eq + 1);
+  bool name_ok = !o.name.empty();
+  for (char c : o.name) name_ok = name_ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+  if (!name_ok)
+    throw Error(fmt::format("{}: expected NAME=VALUE with a parameter name before '=' (e.g. maxdepth=8), got '{}'",
+                            option, text));
+  return o;
+}
+
+std::vector<Param> typed_param_overrides(const std::string& integrator, const std::vector<ParamOverride>& overrides,
+                                         Registry& registry) {
+  std::vector<Param> out;
+  if (overrides.empty()) return out;
+  const PluginInfo& info = *registry.load(PluginKind::Integrator, integrator).info;
+  std::string what = fmt::format("integrator '{}'", info.name);
+  for (const ParamOverride& o : overrides) {
+    const ParamSpec* match = nullptr;
+    for (size_t i = 0; i < info.param_count; ++i)
+      if (o.name == info.params[i].name) match = &info.params[i];
+    if (!match) {
+      std::string best, names;
+      size_t best_d = SIZE_MAX;
+      for (size_t i = 0; i < info.param_count; ++i) {
+        if (std::string(info.params[i].type) == "unsupported") continue;
+        size_t d = edit_distance(o.name, info.params[i].name);
+        if (d < best_d) best_d = d, best = info.params[i].name;
+        names += fmt::format("{}{}", names.empty() ? "" : ", ", info.params[i].name);
+      }
+      std::string hint = !best.empty() && best_d <= std::max<size_t>(2, o.name.size() / 3)
+                             ? fmt::format("; did you mean '{}'?", best)
+                             : fmt::format("; it takes: {}", names.empty() ? "no parameters" : names);
+      throw Error(fmt::format("{}: unknown parameter '{}' for {}{}", o.origin, o.name, what, hint));
+    }
+    if (std::string(match->type) == "unsupported")
+      throw Error(fmt::format("{}: parameter '{}' of {} is not supported by Penumbra{}{}", o.origin, o.name, what,
+                              match->doc && *match->doc ? ": " : "", match->doc ? match->doc : ""));
+    Param p = typed_param(*match, o, what);
+    auto same = std::find_if(out.begin(), out.end(), [&](const Param& q) { return q.name == p.name; });
+    if (same != out.end())
+      *same = std::move(p);
+    else
+      out.push_back(std::move(p));
+  }
+  return out;
+}
+
+void check_param_overrides(const std::string& integrator, const std::vector<ParamOverride>& overrides,
+                           const std::vector<std::string>& plugin_dirs) {
+  Registry registry(plugin_dirs.empty() ? Registry::default_search_dirs() : plugin_dirs);
+  typed_param_overrides(integrator, overrides, registry);
+}
 
 RenderResult render(const RenderSettings& settings) {
   auto t0 = Clock::now();
@@ -123,6 +278,17 @@ RenderResult render(const RenderSettings& settings) {
     override_plugin(desc.integrator, PluginKind::Integrator, settings.integrator, registry);
   if (!settings.sampler.empty())
     override_plugin(desc.sampler, PluginKind::Sampler, settings.sampler, registry);
+  // --param NAME=VALUE, after --integrator: typed by the integrator's table, replacing the file's value.
+  std::vector<Param> overrides = typed_param_overrides(
+      desc.integrator.type.empty() ? kDefaultIntegrator : desc.integrator.type, settings.integrator_params, registry);
+  if (!overrides.empty()) {
+    ParamSet params;
+    for (const Param& p : desc.integrator.params.params())
+      if (std::none_of(overrides.begin(), overrides.end(), [&](const Param& o) { return o.name == p.name; }))
+        params.add(p);
+    for (const Param& p : overrides) params.add(p);
+    desc.integrator.params = std::move(params);
+  }
   if (settings.spp) {
     if (*settings.spp <= 0) throw Error("--spp must be positive");
     desc.sampler.params.set_int("pixelsamples", *settings.spp);
@@ -139,7 +305,16 @@ RenderResult render(const RenderSettings& settings) {
   int threads = settings.threads > 0 ? settings.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
 
-  BuiltScene built = build_scene(desc, registry);
+  BuiltScene built;
+  try {
+    built = build_scene(desc, registry);
+  } catch (const Error& e) {
+    // An integrator's complaint about an overridden value names the option, not a file position.
+    for (const Param& p : overrides)
+      if (e.loc().filename && e.loc().filename == p.loc.filename)
+        throw Error(fmt::format("{}: {}", *p.loc.filename, e.what()));
+    throw;
+  }
   built.film->set_firefly_threshold(settings.firefly_threshold);
   RenderOptions options;
   options.time_budget = settings.time_budget;
@@ -191,6 +366,8 @@ RenderResult render(const RenderSettings& settings) {
   s.first_sample = options.first_sample;
   s.spp_total = range.split ? range.total : s.spp;
   s.aovs = built.film->aovs().names();
+  s.integrator_stats = built.integrator->statistics();
+  for (const ParamOverride& o : settings.integrator_params) s.integrator_params.emplace_back(o.name, o.value);
   if (s.nonfinite_samples > 0)
     warning({}, fmt::format("{} non-finite samples were discarded (first at pixel {}, {})",
                             s.nonfinite_samples, s.first_nonfinite_pixel->first,
@@ -227,6 +404,11 @@ std::string stats_json(const RenderStats& s) {
   j["scene_hash"] = s.scene_hash;
   j["spp_total"] = s.spp_total;
   j["first_sample"] = s.first_sample;
+  nlohmann::json integrator_stats = nlohmann::json::object();
+  for (const auto& [name, value] : s.integrator_stats) integrator_stats[name] = value;
+  j["integrator_stats"] = integrator_stats;
+  j["integrator_params"] = nlohmann::json::object();
+  for (const auto& [name, value] : s.integrator_params) j["integrator_params"][name] = value;
   return j.dump(2) + "\n";
 }
 

@@ -5,6 +5,8 @@
 #include "image/exr_layers.h"
 #include "image/image_io.h"
 
+#include <penumbra/params.h>
+
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -12,6 +14,29 @@
 #include <vector>
 
 namespace penumbra {
+
+class Registry;
+
+/// One integrator parameter set on the command line (`--param NAME=VALUE`, or `/NAME=VALUE` in a
+/// `penumbra converge` configuration). VALUE is text; its type comes from the integrator's
+/// parameter table. `origin` prefixes every error about it, e.g. "--param maxdepth=abc".
+struct ParamOverride {
+  std::string name, value, origin;
+};
+
+/// Splits "NAME=VALUE" (VALUE may be empty for strings). `option` names where it came from
+/// ("--param"); a missing '=' or an empty or malformed NAME is an Error that names it.
+ParamOverride parse_param_override(const std::string& text, const std::string& option = "--param");
+
+/// Turns overrides into typed parameters of integrator `integrator` (a name or alias) by its declared
+/// table: an unknown name (with a did-you-mean), an "unsupported" parameter or a value that does not
+/// parse as the declared type is an Error starting with the override's origin. Returns one Param
+/// per override (a later override of the same name replaces an earlier one).
+std::vector<Param> typed_param_overrides(const std::string& integrator, const std::vector<ParamOverride>& overrides,
+                                         Registry& registry);
+/// The same check without rendering, for validating before long work (`penumbra converge`).
+void check_param_overrides(const std::string& integrator, const std::vector<ParamOverride>& overrides,
+                           const std::vector<std::string>& plugin_dirs = {});
 
 /// Command-line choices; each one, when set, overrides what the scene file says.
 struct RenderSettings {
@@ -23,6 +48,7 @@ struct RenderSettings {
   std::optional<uint32_t> seed;
   std::string integrator;                // --integrator NAME
   std::string sampler;                   // --sampler NAME
+  std::vector<ParamOverride> integrator_params;  // --param NAME=VALUE, applied after --integrator
   std::optional<std::pair<int, int>> resolution;  // --res WxH
   std::string stats_file;                // --stats FILE.json
   bool quiet = false;                    // no progress output
@@ -62,6 +88,8 @@ struct RenderStats {
   int spp_total = 0;           // samples of the whole render this one is a part of (= spp unsplit)
   int first_sample = 0;        // index of this render's first sample
   std::string aovs;            // AOVs written, e.g. "albedo,samples"
+  std::vector<std::pair<std::string, std::string>> integrator_params;  // overrides given, as text
+  std::vector<std::pair<std::string, double>> integrator_stats;  // Object::statistics() of the integrator
   double mrays_per_second() const { return seconds > 0 ? rays / seconds * 1e-6 : 0.0; }
 };
 

@@ -22,6 +22,8 @@ uint64_t pixel_key(Point2i p) { return (static_cast<uint64_t>(static_cast<uint32
 
 std::atomic<uint64_t> next_connector_id{1};
 
+constexpr double kPcWeightBound = 8.0;  // record weights are capped at this multiple of the pilot mean
+
 bool is_connectible_surface(const Vertex& v) { return v.kind == VertexKind::Surface && v.bsdf && v.connectible(); }
 
 // Pilot camera paths: one through the centre of every `stride`-th pixel in x and y, traced with an
@@ -98,7 +100,14 @@ double CachedConnector::pc_weight(const Vertex& y_prev, const Vertex& y, int cp)
   Rgb f = y.bsdf->f(y.shading.to_local(wo), y.shading.to_local(wi), ShadingContext{y.uv, TransportMode::Importance});
   double w = luminance(f) * std::abs(glm::dot(y.ns, wi)) * std::abs(glm::dot(point.n, wi)) /
              std::max(dist2, pc_radius_ * pc_radius_);
-  return std::isfinite(w) && w > 0.0 ? w : 0.0;
+  if (!std::isfinite(w) || !(w > 0.0)) return 0.0;
+  // Bounded weights: the MIS approximates the selection probability with the pilot's mean record
+  // weight; a record far above it (a glossy light vertex aimed at the cache point) would make one
+  // iteration's PMF much more peaked than that approximation, and samples drawn with a true
+  // probability far below the approximate one become fireflies. With w <= kappa * mean, the true
+  // probability is never below 1/kappa of the approximation. The same bound holds in the MIS.
+  if (pc_.frozen()) w = std::min(w, kPcWeightBound * pc_.frozen_mean_weight(cp));
+  return w;
 }
 
 namespace {
