@@ -15,6 +15,7 @@
 #include "registry/registry.h"
 #include "render/render_session.h"
 #include "scene/scene_builder.h"
+#include "support/bundled_scenes.h"
 #include "support/command.h"
 #include "support/image_stats.h"
 
@@ -249,19 +250,9 @@ TEST(BdptCached, FurnaceForEveryCombination) {
 
 namespace {
 
-const std::string kCornellDir = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box";
-
 // The Cornell box with a box filter (splats land in one pixel) and the given Integrator line.
 std::string cornell_box(const std::string& name, const std::string& integrator_line) {
-  std::string dir = test::temp_dir("cached-cornell-" + name);
-  std::string text = test::read_file(kCornellDir + "/scene.pbrt");
-  size_t at = text.find("PixelFilter \"gaussian\"");
-  text.replace(at, std::string("PixelFilter \"gaussian\"").size(), "PixelFilter \"box\"");
-  size_t i = text.find("\nIntegrator ");
-  size_t e = text.find('\n', i + 1);
-  text.replace(i + 1, e - i - 1, integrator_line);
-  test::write_file(dir, "unit-cube.pbrt", test::read_file(kCornellDir + "/unit-cube.pbrt"));
-  return test::write_file(dir, "scene.pbrt", text);
+  return test::cornell_box_copy("cached-cornell-" + name, integrator_line, true);
 }
 
 RenderResult render_file(const std::string& file, int spp, int seed, int threads = 0) {

@@ -10,6 +10,7 @@
 #include "registry/registry.h"
 #include "render/render_session.h"
 #include "scene/scene_builder.h"
+#include "support/bundled_scenes.h"
 #include "support/command.h"
 #include "support/image_stats.h"
 #include "support/pcg32.h"
@@ -352,14 +353,7 @@ const std::string kCornellDir = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/corn
 
 // The Cornell box with a box filter: splats (light tracing) land in one pixel, unfiltered, so with a
 // wider filter the pixel samples would blur the light's edges differently.
-std::string cornell_box_filtered() {
-  std::string dir = test::temp_dir("cornell-box");
-  std::string text = test::read_file(kCornellDir + "/scene.pbrt");
-  size_t at = text.find("PixelFilter \"gaussian\"");
-  text.replace(at, std::string("PixelFilter \"gaussian\"").size(), "PixelFilter \"box\"");
-  test::write_file(dir, "unit-cube.pbrt", test::read_file(kCornellDir + "/unit-cube.pbrt"));
-  return test::write_file(dir, "scene.pbrt", text);
-}
+std::string cornell_box_filtered() { return test::cornell_box_copy("cornell-box", "", true); }
 
 }  // namespace
 

@@ -10,6 +10,7 @@
 #include "registry/registry.h"
 #include "render/render_session.h"
 #include "scene/scene_builder.h"
+#include "support/bundled_scenes.h"
 #include "support/command.h"
 #include "support/image_stats.h"
 
@@ -53,12 +54,7 @@ RenderResult render_text(const std::string& name, const std::string& text, int t
 // The bundled Cornell box with its Integrator line replaced, in a temporary folder (it includes
 // unit-cube.pbrt from beside it).
 std::string cornell_with_integrator(const std::string& name, const std::string& integrator_line) {
-  std::string src = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/";
-  std::string text = test::read_file(src + "scene.pbrt");
-  text = std::regex_replace(text, std::regex("Integrator \"path\"[^\n]*"), integrator_line);
-  std::string dir = test::temp_dir(name);
-  test::write_file(dir, "unit-cube.pbrt", test::read_file(src + "unit-cube.pbrt"));
-  return test::write_file(dir, "scene.pbrt", text);
+  return test::cornell_box_copy(name, integrator_line);
 }
 
 ImageRgb render_cornell(const std::string& scene_file, int spp, uint32_t seed, int threads = 0) {

@@ -273,6 +273,7 @@ void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camer
   if (opt_.hrr && bvh_.vertex_count() > 0) {
     SelLobe lobe = eye_lobe(z, camera[t - 2]);
     if (lobe.c > 0.0) {
+      hrr_eye_vertices_.fetch_add(1, std::memory_order_relaxed);
       HrrRandom rng{hash_ints(opt_.seed, pixel_key(pixel), index, static_cast<uint64_t>(t))};
       HrrTraversalStats stats;
       hrr_traverse(
@@ -322,6 +323,9 @@ std::vector<std::pair<std::string, double>> CachedConnector::statistics() const 
   if (opt_.hrr) {
     s.push_back({"hrr_c", C_});
     s.push_back({"hrr_connections_per_eye_vertex", hrr_accepted_.load() / eyes});
+    s.push_back({"hrr_eye_vertex_fraction", hrr_eye_vertices_.load() / eyes});
+    s.push_back({"hrr_connections_per_hrr_eye_vertex",
+                 hrr_accepted_.load() / std::max<double>(1.0, static_cast<double>(hrr_eye_vertices_.load()))});
     s.push_back({"hrr_nodes_visited_per_eye_vertex", hrr_nodes_.load() / eyes});
     s.push_back({"light_vertex_bvh_build_seconds", build_seconds_ / iters});
     s.push_back({"light_vertex_bvh_bytes_per_vertex",

@@ -86,7 +86,7 @@ class CachedConnector final : public CachedTechniques {
   ConnectionCache pc_;
   float pc_radius_ = 0.f;
   // statistics
-  mutable std::atomic<uint64_t> eye_vertices_{0}, hrr_accepted_{0}, hrr_nodes_{0}, pc_draws_{0};
+  mutable std::atomic<uint64_t> eye_vertices_{0}, hrr_eye_vertices_{0}, hrr_accepted_{0}, hrr_nodes_{0}, pc_draws_{0};
   double build_seconds_ = 0.0, trace_seconds_ = 0.0, calibration_seconds_ = 0.0;
   uint64_t iterations_ = 0, cached_vertices_ = 0;
   size_t bvh_bytes_ = 0, bvh_vertices_ = 0;

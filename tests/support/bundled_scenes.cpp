@@ -1,0 +1,27 @@
+#include "support/bundled_scenes.h"
+
+#include "support/command.h"
+
+namespace penumbra::test {
+
+std::string cornell_box_copy(const std::string& name, const std::string& integrator_line, bool box_filter) {
+  const std::string src = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/";
+  std::string text = read_file(src + "scene.pbrt");
+  if (box_filter) {
+    const std::string gaussian = "PixelFilter \"gaussian\"";
+    size_t at = text.find(gaussian);
+    if (at != std::string::npos) text.replace(at, gaussian.size(), "PixelFilter \"box\"");
+  }
+  if (!integrator_line.empty()) {
+    size_t at = text.find("\nIntegrator ");
+    if (at != std::string::npos) {
+      size_t end = text.find('\n', at + 1);
+      text.replace(at + 1, end - at - 1, integrator_line);
+    }
+  }
+  std::string dir = temp_dir(name);
+  write_file(dir, "unit-cube.pbrt", read_file(src + "unit-cube.pbrt"));
+  return write_file(dir, "scene.pbrt", text);
+}
+
+}  // namespace penumbra::test

@@ -1,0 +1,13 @@
+// Copies of the bundled scenes with test-specific changes, written to a temporary folder.
+#pragma once
+
+#include <string>
+
+namespace penumbra::test {
+
+/// The bundled Cornell box (scenes/cornell-box) in temp_dir(name) with its Integrator line replaced
+/// by `integrator_line` (kept when empty) and, if `box_filter`, a box pixel filter instead of the
+/// Gaussian (splats then land in one pixel, as pixel samples do). Returns the scene file's path.
+std::string cornell_box_copy(const std::string& name, const std::string& integrator_line, bool box_filter = false);
+
+}  // namespace penumbra::test
