@@ -21,7 +21,7 @@ has() { grep -q "$1 '$2'" <<<"$plugins"; }
 studies=(
   "cornell-box|scenes/cornell-box/scene.pbrt|path:independent path:sobol path:halton bdpt:sobol sppm:halton|path:sobol"
   "environment|scenes/environment/scene.pbrt|path:independent path:sobol bdpt:sobol sppm:halton|path:sobol"
-  "caustics|scenes/caustics/scene.pbrt|path:sobol bdpt:sobol sppm:halton|bdpt:sobol"
+  "caustics|scenes/caustics/scene.pbrt|path:sobol bdpt:sobol bdpt/hrr=true:sobol sppm:halton|bdpt:sobol"
   "sppm-caustics|scenes/sppm-caustics/scene.pbrt|path:sobol bdpt:sobol sppm:halton|sppm:halton"
 )
 out=docs/convergence
@@ -31,8 +31,9 @@ for study in "${studies[@]}"; do
   if [ -n "${SCENES:-}" ] && ! grep -qw "$name" <<<"$SCENES"; then continue; fi
   [ -f "$scene" ] || { echo "skipping $name: $scene does not exist yet" >&2; continue; }
   list=()
-  for c in $configs; do has integrator "${c%%:*}" && list+=("$c"); done
-  has integrator "${refconfig%%:*}" || refconfig="path:sobol"
+  # A configuration may set integrator parameters: integrator[/NAME=VALUE...][:sampler].
+  for c in $configs; do has integrator "${c%%[:/]*}" && list+=("$c"); done
+  has integrator "${refconfig%%[:/]*}" || refconfig="path:sobol"
   joined=$(IFS=,; echo "${list[*]}")
   echo "== $name: $joined (reference $refconfig, ${REF}s)" >&2
   $bin converge "$scene" --configs "$joined" --make-reference "$REF" --reference-config "$refconfig" \
