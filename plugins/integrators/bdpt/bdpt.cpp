@@ -266,25 +266,7 @@ Object* create(const CreateContext& ctx) {
   techniques.connect = p.get_bool("connect");
   techniques.nextevent = p.get_bool("nextevent");
   techniques.lighttrace = p.get_bool("lighttrace");
-  CachedOptions cached;
-  cached.hrr = p.get_bool("hrr");
-  cached.hrr_c = p.get_float("hrrc");
-  if (!(cached.hrr_c >= 0.0) || !std::isfinite(cached.hrr_c))
-    throw Error(p.loc_of("hrrc"), "hrrc must be a finite number >= 0 (0: calibrate to hrrconnections)");
-  int target = p.get_int("hrrconnections");
-  if (target < 1) throw Error(p.loc_of("hrrconnections"), "hrrconnections must be >= 1");
-  cached.hrr_target = target;
-  cached.hrr_cull = p.get_bool("hrrcull");
-  cached.hrr_max_alpha = p.get_float("hrrmaxalpha");
-  if (!(cached.hrr_max_alpha > 0.0)) throw Error(p.loc_of("hrrmaxalpha"), "hrrmaxalpha must be > 0");
-  cached.probconnect = p.get_bool("probconnect");
-  cached.pc_connections = p.get_int("probconnections");
-  if (cached.pc_connections < 1) throw Error(p.loc_of("probconnections"), "probconnections must be >= 1");
-  cached.pc_records = p.get_int("pcrecords");
-  if (cached.pc_records < 1) throw Error(p.loc_of("pcrecords"), "pcrecords must be >= 1");
-  int paths = p.get_int("lightpaths");
-  if (paths < 0) throw Error(p.loc_of("lightpaths"), "lightpaths must be >= 0 (0: the pixel count)");
-  cached.light_paths = static_cast<size_t>(paths);
+  CachedOptions cached = read_cached_options(p);
   return new BdptIntegrator(config, uniform_lights, p.get_bool("visualizestrategies"), p.get_bool("visualizeweights"),
                             p.get_string("visualizeprefix"), techniques, cached);
 }

@@ -151,24 +151,34 @@ EyeMemo& eye_memo(uint64_t owner, const Vertex& z, const Vertex& z_next) {
 
 }  // namespace
 
+const std::optional<HrrRange>& CachedConnector::eye_range(const Vertex& z, const Vertex& z_next) const {
+  EyeMemo& memo = eye_memo(id_, z, z_next);
+  if (!memo.has_range) {
+    SelLobe lobe = eye_lobe(z, z_next);
+    if (lobe.c > 0.0) memo.range.emplace(lobe, C_);
+    memo.has_range = true;
+  }
+  return memo.range;
+}
+
+int CachedConnector::eye_cache_point(const Vertex& z, const Vertex& z_next) const {
+  EyeMemo& memo = eye_memo(id_, z, z_next);
+  if (!memo.has_cache_point) {
+    memo.cache_point = pc_.lookup(z.p, z.ng);
+    memo.has_cache_point = true;
+  }
+  return memo.cache_point;
+}
+
 double CachedConnector::factor(Technique tau, const Vertex& y_prev, const Vertex& y, const Vertex& z,
                                const Vertex& z_next) const {
   if (!is_connectible_surface(y) || !is_connectible_surface(z)) return 0.0;
-  EyeMemo& memo = eye_memo(id_, z, z_next);
   if (tau == Technique::Hrr && opt_.hrr) {
-    if (!memo.has_range) {
-      SelLobe lobe = eye_lobe(z, z_next);
-      if (lobe.c > 0.0) memo.range.emplace(lobe, C_);
-      memo.has_range = true;
-    }
-    return memo.range ? static_cast<double>(M_) * memo.range->acceptance(y.p) : 0.0;
+    const std::optional<HrrRange>& range = eye_range(z, z_next);
+    return range ? static_cast<double>(M_) * range->acceptance(y.p) : 0.0;
   }
   if (tau == Technique::ProbConnect && opt_.probconnect) {
-    if (!memo.has_cache_point) {
-      memo.cache_point = pc_.lookup(z.p, z.ng);
-      memo.has_cache_point = true;
-    }
-    int cp = memo.cache_point;
+    int cp = eye_cache_point(z, z_next);
     if (cp < 0) return 0.0;
     return opt_.pc_connections * static_cast<double>(M_) * pc_.approx_probability(cp, pc_weight(y_prev, y, cp));
   }
@@ -280,13 +290,14 @@ void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camer
   if (t < 2 || !is_connectible_surface(z)) return;
   eye_vertices_.fetch_add(1, std::memory_order_relaxed);
   if (opt_.hrr && bvh_.vertex_count() > 0) {
-    SelLobe lobe = eye_lobe(z, camera[t - 2]);
-    if (lobe.c > 0.0) {
+    // A copy: the connections' MIS weights reuse the per-thread memo while the traversal runs.
+    const std::optional<HrrRange> range = eye_range(z, camera[t - 2]);
+    if (range) {
       hrr_eye_vertices_.fetch_add(1, std::memory_order_relaxed);
       HrrRandom rng{hash_ints(opt_.seed, pixel_key(pixel), index, static_cast<uint64_t>(t))};
       HrrTraversalStats stats;
       hrr_traverse(
-          bvh_, lobe, C_, rng,
+          bvh_, *range, rng,
           [&](uint32_t v, double P, double) {
             LightCache::Ref r = cache_.ref(v);
             int s = static_cast<int>(r.vertex) + 1;
@@ -301,7 +312,7 @@ void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camer
     }
   }
   if (opt_.probconnect && cache_.vertex_count() > 0) {
-    int cp = pc_.lookup(z.p, z.ng);
+    int cp = eye_cache_point(z, camera[t - 2]);
     if (cp < 0) return;
     Pcg32 rng(hash_ints(opt_.seed, pixel_key(pixel), index, static_cast<uint64_t>(t)), 0x50434f4eu /* "PCON" */);
     for (int d = 0; d < opt_.pc_connections; ++d) {
@@ -346,6 +357,29 @@ std::vector<std::pair<std::string, double>> CachedConnector::statistics() const 
     s.push_back({"pc_bytes", static_cast<double>(pc_.memory_bytes())});
   }
   return s;
+}
+
+CachedOptions read_cached_options(const ParamSet& p) {
+  CachedOptions o;
+  o.hrr = p.get_bool("hrr");
+  o.hrr_c = p.get_float("hrrc");
+  if (!(o.hrr_c >= 0.0) || !std::isfinite(o.hrr_c))
+    throw Error(p.loc_of("hrrc"), "hrrc must be a finite number >= 0 (0: calibrate to hrrconnections)");
+  int target = p.get_int("hrrconnections");
+  if (target < 1) throw Error(p.loc_of("hrrconnections"), "hrrconnections must be >= 1");
+  o.hrr_target = target;
+  o.hrr_cull = p.get_bool("hrrcull");
+  o.hrr_max_alpha = p.get_float("hrrmaxalpha");
+  if (!(o.hrr_max_alpha > 0.0)) throw Error(p.loc_of("hrrmaxalpha"), "hrrmaxalpha must be > 0");
+  o.probconnect = p.get_bool("probconnect");
+  o.pc_connections = p.get_int("probconnections");
+  if (o.pc_connections < 1) throw Error(p.loc_of("probconnections"), "probconnections must be >= 1");
+  o.pc_records = p.get_int("pcrecords");
+  if (o.pc_records < 1) throw Error(p.loc_of("pcrecords"), "pcrecords must be >= 1");
+  int paths = p.get_int("lightpaths");
+  if (paths < 0) throw Error(p.loc_of("lightpaths"), "lightpaths must be >= 0 (0: the pixel count)");
+  o.light_paths = static_cast<size_t>(paths);
+  return o;
 }
 
 }  // namespace penumbra::bdpt

@@ -21,6 +21,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,10 @@ struct CachedOptions {
   size_t light_paths = 0;      // M; 0: the pixel count
   uint64_t seed = 0;
 };
+
+/// Reads and checks bdpt's parameters of the cached techniques (hrr*, probconnect, probconnections,
+/// pcrecords, lightpaths); throws located errors. The seed is set at render time.
+CachedOptions read_cached_options(const ParamSet& p);
 
 class CachedConnector final : public CachedTechniques {
  public:
@@ -66,6 +71,11 @@ class CachedConnector final : public CachedTechniques {
 
   /// The lobe of eye vertex z towards its eye-side neighbour (c = 0: HRR does not apply at z).
   SelLobe eye_lobe(const Vertex& z, const Vertex& z_next) const;
+  /// HRR's acceptance range at eye vertex z (empty: HRR does not apply there) and z's cache point
+  /// (-1: none), from a small per-thread memo: the MIS weights of a sample's connections ask for the
+  /// same eye vertices again and again. The reference is valid until the next call on this thread.
+  const std::optional<HrrRange>& eye_range(const Vertex& z, const Vertex& z_next) const;
+  int eye_cache_point(const Vertex& z, const Vertex& z_next) const;
   /// Probabilistic connections' weight of light vertex y (reached from y_prev) for cache point cp.
   double pc_weight(const Vertex& y_prev, const Vertex& y, int cp) const;
 

@@ -327,11 +327,11 @@ class HrrRange {
 /// Tokuyoshi & Harada's Algorithm 1 with the stratified minimum. A leaf (vertex y) is accepted iff
 /// xi_min < P(y, z); then accept(vertex_index, P, xi_leaf) is called. With cull = true, nodes whose
 /// box cannot meet the acceptance region of their xi_min (the ellipsoid cut by the half space) are
-/// skipped; that changes only the cost, never the accepted pairs.
+/// skipped; that changes only the cost, never the accepted pairs. This form takes the eye vertex's
+/// range already built (for callers that also need P elsewhere); the one below builds it.
 template <class Accept>
-void hrr_traverse(const LightVertexBvh& bvh, const SelLobe& lobe, double C, const HrrRandom& rng,
-                  Accept&& accept, bool cull = true, HrrTraversalStats* stats = nullptr) {
-  const HrrRange range(lobe, C);
+void hrr_traverse(const LightVertexBvh& bvh, const HrrRange& range, const HrrRandom& rng, Accept&& accept,
+                  bool cull = true, HrrTraversalStats* stats = nullptr) {
   using Node = LightVertexBvh::Node;
   hrr_walk(
       bvh, rng,
@@ -344,6 +344,12 @@ void hrr_traverse(const LightVertexBvh& bvh, const SelLobe& lobe, double C, cons
         }
       },
       stats);
+}
+
+template <class Accept>
+void hrr_traverse(const LightVertexBvh& bvh, const SelLobe& lobe, double C, const HrrRandom& rng,
+                  Accept&& accept, bool cull = true, HrrTraversalStats* stats = nullptr) {
+  hrr_traverse(bvh, HrrRange(lobe, C), rng, std::forward<Accept>(accept), cull, stats);
 }
 
 }  // namespace penumbra::bdpt
