@@ -4,12 +4,13 @@
 // whole renders: the furnace and the Cornell box agree with "path" for every combination of
 // techniques, images are the same on 1 and 2 threads, stats report the figures.
 //
-// The integrator's sources are compiled into this test (tests only glob test files).
-#include "../plugins/integrators/bdpt/subpath.cpp"
-#include "../plugins/integrators/bdpt/light_cache.cpp"
-#include "../plugins/integrators/bdpt/hrr.cpp"
-#include "../plugins/integrators/bdpt/prob_connect.cpp"
-#include "../plugins/integrators/bdpt/connect_cached.cpp"
+// The test links the bidirectional library (libs/bidirectional) that the plugins link, so the weights
+// and estimates checked are the ones the plugins compute.
+#include "subpath.h"
+#include "light_cache.h"
+#include "hrr.h"
+#include "prob_connect.h"
+#include "connect_cached.h"
 
 #include "parser/scene_description.h"
 #include "registry/registry.h"

@@ -2,9 +2,9 @@
 // agreement with the path tracer on whole renders (analytic furnace, Cornell box, point and spot
 // lights, environment), determinism of the splats, strategy images, and no NaN/Inf anywhere.
 //
-// The integrator's shared code is compiled into this test directly (tests only glob test files), so
-// the weights checked are the ones the plugin computes.
-#include "../plugins/integrators/bdpt/subpath.cpp"
+// The test links the bidirectional library (libs/bidirectional) that the plugins link, so the weights
+// and estimates checked are the ones the plugins compute.
+#include "subpath.h"
 
 #include "parser/scene_description.h"
 #include "registry/registry.h"

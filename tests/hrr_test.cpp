@@ -1,4 +1,4 @@
-// Hierarchical Russian roulette (plugins/integrators/bdpt/hrr.*; ALGORITHMS.md section 1):
+// Hierarchical Russian roulette (libs/bidirectional/hrr.*; ALGORITHMS.md section 1):
 //  1. every leaf's number is marginally U[0,1] (KS per leaf), and the seed's buggy pseudo-code fails;
 //  2. culling is conservative: culled and unculled traversals accept exactly the same pairs;
 //  3. the mean accepted count is sum_i P(y_i, z);
@@ -10,7 +10,7 @@
 //
 // The plugin's source is compiled in directly (tests only glob test files), so what is tested is
 // what the plugin runs. All randomness is seeded.
-#include "../plugins/integrators/bdpt/hrr.cpp"
+#include "hrr.h"
 
 #include <penumbra/microfacet.h>
 

@@ -2,10 +2,10 @@
 // sample() draws slots with the probabilities it reports, the estimator g(y) V / (R n_c P_r) is
 // unbiased for the sum over all vertices, the frozen MIS approximation sums to about one and ignores
 // later builds, the grid lookup equals brute force, and the records do not depend on the thread count.
-//
-// The module is compiled into the test directly (tests only glob test files), as bdpt_test.cpp does
-// with subpath.cpp.
-#include "../plugins/integrators/bdpt/prob_connect.cpp"
+// The test links the bidirectional library (libs/bidirectional), as the bdpt plugin does.
+#include "prob_connect.h"
+
+#include <penumbra/rng.h>
 
 #include "support/chi_square.h"
 #include "support/pcg32.h"
@@ -18,6 +18,13 @@
 #include <numeric>
 
 using namespace penumbra;
+
+namespace {
+double distance_squared(const Vec3& a, const Vec3& b) {
+  Vec3 d = a - b;
+  return static_cast<double>(d.x) * d.x + static_cast<double>(d.y) * d.y + static_cast<double>(d.z) * d.z;
+}
+}  // namespace
 using namespace penumbra::bdpt;
 
 namespace {

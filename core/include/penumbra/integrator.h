@@ -1,10 +1,12 @@
-// Integrators own their render loop. Most estimate each pixel sample on its own: they derive from
-// PixelIntegrator and implement Li(); the runtime then renders tiles in parallel (oneTBB), in passes
-// of samples so that a time budget or a snapshot never cuts a pass, shows progress, and discards
-// non-finite samples (counted in the stats) before they reach the film.
+// Integrators plug into the core's one render loop. The loop owns tiles, passes of samples, sample
+// indices, the time budget, progress, AOVs, non-finite guards and splats; an integrator supplies the
+// estimate of one pixel sample (SampleIntegrator::sample) and, where its algorithm needs it, work
+// before and after each pass (a light-vertex cache, a photon pass). Most integrators estimate each
+// pixel sample on its own from the camera ray: they derive from PixelIntegrator and implement Li().
 #pragma once
 
 #include <penumbra/bsdf.h>
+#include <penumbra/camera.h>
 #include <penumbra/film.h>
 #include <penumbra/image.h>
 #include <penumbra/object.h>
@@ -37,15 +39,21 @@ class RenderContext {
   virtual const RenderOptions& options() const = 0;
   /// Seconds since the render started.
   virtual double elapsed() const = 0;
+  /// True once the render should end as soon as possible (the time budget is spent); work that
+  /// takes long (a photon pass) checks it between batches. Thread-safe.
+  virtual bool should_stop() const = 0;
   /// Reports progress in units of `total` (e.g. pixel samples); thread-safe.
   virtual void progress(uint64_t done, uint64_t total) = 0;
   /// Records a discarded non-finite sample at `pixel`; thread-safe.
   virtual void report_nonfinite(Point2i pixel) = 0;
-  /// Records that `spp` samples per pixel (or iterations) are complete; call it after every whole
-  /// pass. The runtime may then take a snapshot of the current estimate (convergence studies): from
-  /// the film, or, when the film does not hold the estimate (photon mapping), from `estimate`, which
-  /// it calls only for a snapshot. Time spent in snapshots is excluded from elapsed().
-  virtual void set_completed_spp(int spp, const std::function<ImageRgb()>& estimate = {}) = 0;
+  /// Records that `spp` samples per pixel (or iterations) are complete; called after every pass.
+  /// `splat_spp` is what the film's splats are divided by (the pixel samples taken over the pixel
+  /// count; it exceeds `spp` when a pass was cut short by the time budget; 0: `spp`). The runtime
+  /// may take a snapshot of the current estimate (convergence studies): from the film or, when the
+  /// film does not hold the estimate (photon mapping), from `estimate`, which it calls only for a
+  /// snapshot. Time spent in snapshots is excluded from elapsed().
+  virtual void set_completed_spp(int spp, const std::function<ImageRgb()>& estimate = {},
+                                 double splat_spp = 0.0) = 0;
 };
 
 class Integrator : public Object {
@@ -54,11 +62,75 @@ class Integrator : public Object {
   virtual void render(RenderContext& ctx) = 0;
 };
 
-/// Base for integrators whose pixel samples are independent (path tracing and its relatives).
-class PixelIntegrator : public Integrator {
+/// Receives light a pixel sample finds for arbitrary film positions (light paths connected to the
+/// lens). Each thread has its own; the core sums them so that the image does not depend on the
+/// thread count or scheduling. Values are divided by the samples per pixel when the image is made.
+class SplatSink {
+ public:
+  virtual void splat(const Vec2& p_raster, const Rgb& value) = 0;
+
+ protected:
+  ~SplatSink() = default;
+};
+
+/// One pixel sample as the render loop hands it over: the sampler has been started at
+/// (pixel, index) and has already given the film position and the lens position.
+struct PixelSample {
+  Point2i pixel;
+  uint32_t index = 0;      // sample index in the render's one sequence (split renders included)
+  CameraSample camera;     // raster position (filter offset applied) and lens position
+  const Ray* ray = nullptr;  // the camera ray; null when none leaves the lens
+};
+
+/// A run of sample indices [first_index, first_index + count) rendered for every pixel.
+struct Pass {
+  uint32_t first_index = 0;
+  int count = 1;
+  bool complete = true;    // end_pass(): false when the time budget cut the pass short
+};
+
+/// Base for every integrator that renders pixel samples: the core's render loop. Passes of samples
+/// (1, 2, 4, ... up to max_pass_samples() per pixel, sized to fit a time budget) run over 16x16
+/// tiles in parallel; each pixel's samples are taken in index order by one thread at a time, and
+/// a sample must be a pure function of (pixel, index, seed and the state prepared in begin_pass),
+/// so images are bit-identical for any thread count. When the time budget runs out the loop starts
+/// no further tile; a pass cut short still counts its samples.
+class SampleIntegrator : public Integrator {
+ public:
+  ~SampleIntegrator() override;
+  void render(RenderContext& ctx) final;
+
+  /// The estimate of one pixel sample: radiance for `ps.pixel` (added to the film with the filter
+  /// weight) plus any splats. Called concurrently from several threads.
+  virtual Rgb sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink& splats) = 0;
+
+  /// Once, before the first pass.
+  virtual void begin_render(RenderContext& ctx) {}
+  /// Before each pass, on one thread (e.g. trace and index a light-vertex cache).
+  virtual void begin_pass(RenderContext& ctx, const Pass& pass) {}
+  /// After each pass, on one thread; may run parallel work of its own (a photon pass), checking
+  /// ctx.should_stop() between batches of it and reporting ctx.progress().
+  virtual void end_pass(RenderContext& ctx, const Pass& pass) {}
+  /// Once, after the last pass; `spp` passes' worth of samples were completed.
+  virtual void end_render(RenderContext& ctx, int spp) {}
+  /// Largest number of samples per pixel in one pass (1 when begin_pass prepares per-sample state);
+  /// asked after begin_render().
+  virtual int max_pass_samples() const { return 16; }
+  /// False when the film does not hold the estimate (photon mapping): the loop then adds no pixel
+  /// samples to the film (only AOVs), snapshots ask estimate(), and end_render() fills the film.
+  virtual bool film_holds_estimate() const { return true; }
+  /// The current estimate, when the film does not hold it.
+  virtual ImageRgb estimate() const { return {}; }
+};
+
+/// Base for integrators whose pixel samples are independent estimates along the camera ray (path
+/// tracing and its relatives).
+class PixelIntegrator : public SampleIntegrator {
  public:
   ~PixelIntegrator() override;
-  void render(RenderContext& ctx) override;
+  Rgb sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink& splats) final {
+    return ps.ray ? Li(*ps.ray, sampler, scene) : Rgb(0.f);
+  }
   /// Radiance arriving along the camera ray. Draw random numbers only from `sampler`.
   virtual Rgb Li(const Ray& ray, Sampler& sampler, const Scene& scene) const = 0;
 };

@@ -109,7 +109,7 @@ FilterSample PixelFilter::sample(Vec2 u) const {
 
 FilmRgb::FilmRgb(Point2i resolution, PixelFilter filter, AovSet aovs)
     : resolution_(resolution), filter_(std::move(filter)),
-      pixels_(static_cast<size_t>(resolution.x) * resolution.y) {
+      pixels_(static_cast<size_t>(resolution.x) * resolution.y), splats_(resolution) {
   if (aovs.any()) aovs_ = std::make_unique<FilmAovs>(resolution, aovs);
 }
 
@@ -135,13 +135,7 @@ void FilmRgb::add_splat(const Vec2& p_raster, const Rgb& v) {
   if (max_component(v) > firefly_threshold_) fireflies_.fetch_add(1, std::memory_order_relaxed);
   int x = static_cast<int>(std::floor(p_raster.x)), y = static_cast<int>(std::floor(p_raster.y));
   if (x < 0 || y < 0 || x >= resolution_.x || y >= resolution_.y) return;
-  std::call_once(splat_once_, [&] {
-    size_t n = 3 * pixels_.size();
-    splats_ = std::make_unique<std::atomic<double>[]>(n);
-    for (size_t i = 0; i < n; ++i) splats_[i].store(0.0, std::memory_order_relaxed);
-  });
-  size_t i = 3 * (static_cast<size_t>(y) * resolution_.x + x);
-  for (int c = 0; c < 3; ++c) splats_[i + c].fetch_add(v[c], std::memory_order_relaxed);
+  splats_.add(x, y, v);
 }
 
 ImageRgb FilmRgb::image(double splat_spp) const {
@@ -149,11 +143,13 @@ ImageRgb FilmRgb::image(double splat_spp) const {
   img.width = resolution_.x;
   img.height = resolution_.y;
   img.pixels.resize(3 * pixels_.size());
+  const bool splats = splats_.any() && splat_spp > 0.0;
+  const std::vector<double> splat_sums = splats ? splats_.totals() : std::vector<double>();
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const Pixel& px = pixels_[i];
     for (int c = 0; c < 3; ++c) {
       double v = px.weight != 0.0 ? px.rgb[c] / px.weight : 0.0;
-      if (splats_ && splat_spp > 0.0) v += splats_[3 * i + c].load(std::memory_order_relaxed) / splat_spp;
+      if (splats) v += splat_sums[3 * i + c] / splat_spp;
       img.pixels[3 * i + c] = static_cast<float>(v);
     }
   }

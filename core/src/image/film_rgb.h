@@ -1,8 +1,9 @@
 // The RGB film: double-precision accumulation of filtered pixel samples, a lazily allocated
-// thread-safe splat buffer, and filter importance sampling for box, triangle and Gaussian filters.
+// per-thread splat buffers summed in fixed point (deterministic), and filter importance sampling for box, triangle and Gaussian filters.
 #pragma once
 
 #include "image/film_aovs.h"
+#include "image/splat_buffers.h"
 
 #include <penumbra/film.h>
 #include <penumbra/params.h>
@@ -55,7 +56,7 @@ class FilmRgb final : public Film {
   void add_nonfinite(Point2i pixel);
   /// The image: weighted pixel means plus splats divided by `splat_spp`.
   ImageRgb image(double splat_spp) const;
-  bool has_splats() const { return splats_ != nullptr; }
+  bool has_splats() const { return splats_.any(); }
   /// Firefly guard: samples and splats whose largest component exceeds `threshold` are counted
   /// (not clamped: clamping would bias the image).
   void set_firefly_threshold(float threshold) { firefly_threshold_ = threshold; }
@@ -73,8 +74,7 @@ class FilmRgb final : public Film {
   Point2i resolution_;
   PixelFilter filter_;
   std::vector<Pixel> pixels_;
-  std::unique_ptr<std::atomic<double>[]> splats_;  // allocated on the first splat
-  std::once_flag splat_once_;
+  SplatBuffers splats_;  // per-thread fixed-point sums, allocated where splats land
   float firefly_threshold_ = Infinity;
   std::atomic<uint64_t> fireflies_{0};
   std::unique_ptr<FilmAovs> aovs_;  // null unless AOVs were requested

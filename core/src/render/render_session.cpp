@@ -54,6 +54,9 @@ class Session final : public RenderContext {
   const Sampler& sampler() const override { return *built_.sampler; }
   const RenderOptions& options() const override { return options_; }
   double elapsed() const override { return seconds_since(start_) - snapshot_seconds_; }
+  bool should_stop() const override {
+    return options_.time_budget > 0.0 && elapsed() >= options_.time_budget;
+  }
   void progress(uint64_t done, uint64_t total) override {
     progress_.update(done, total, elapsed(), options_.time_budget);
   }
@@ -64,21 +67,23 @@ class Session final : public RenderContext {
       first_nonfinite_ = {pixel.x, pixel.y};
     }
   }
-  void set_completed_spp(int spp, const std::function<ImageRgb()>& estimate) override {
+  void set_completed_spp(int spp, const std::function<ImageRgb()>& estimate, double splat_spp) override {
     completed_spp_ = spp;
+    splat_spp_ = splat_spp > 0.0 ? splat_spp : spp;
     if (!settings_.on_snapshot || next_snapshot_ >= settings_.snapshot_times.size()) return;
     double t = elapsed();
     if (t < settings_.snapshot_times[next_snapshot_]) return;
     while (next_snapshot_ < settings_.snapshot_times.size() && settings_.snapshot_times[next_snapshot_] <= t)
       ++next_snapshot_;
     auto t0 = Clock::now();
-    settings_.on_snapshot(t, spp, estimate ? estimate() : built_.film->image(spp));
+    settings_.on_snapshot(t, spp, estimate ? estimate() : built_.film->image(splat_spp_));
     snapshot_seconds_ += seconds_since(t0);
   }
 
   void start() { start_ = Clock::now(); }
   void finish() { progress_.finish(elapsed()); }
   int completed_spp() const { return completed_spp_; }
+  double splat_spp() const { return splat_spp_; }
   uint64_t nonfinite() const { return nonfinite_.load(); }
   std::optional<std::pair<int, int>> first_nonfinite() const { return first_nonfinite_; }
 
@@ -94,6 +99,7 @@ class Session final : public RenderContext {
   std::optional<std::pair<int, int>> first_nonfinite_;
   std::mutex mutex_;
   int completed_spp_ = 0;
+  double splat_spp_ = 0.0;
 };
 
 // Replaces a plugin chosen by the scene with one named on the command line. Parameters the new
@@ -335,7 +341,7 @@ RenderResult render(const RenderSettings& settings) {
   session.finish();
 
   RenderResult result;
-  result.image = built.film->image(session.completed_spp());
+  result.image = built.film->image(session.splat_spp());
   result.aovs = built.film->aov_layers();
   if (built.film->has_splats()) built.structures_built.push_back("film_splat_buffer");
   for (const Object* o : {static_cast<const Object*>(built.integrator.get()), static_cast<const Object*>(built.sampler.get())})

@@ -18,6 +18,7 @@ Sampler::~Sampler() = default;
 Bsdf::~Bsdf() = default;
 Light::~Light() = default;
 Integrator::~Integrator() = default;
+SampleIntegrator::~SampleIntegrator() = default;
 PixelIntegrator::~PixelIntegrator() = default;
 RenderContext::~RenderContext() = default;
 Shape::~Shape() = default;

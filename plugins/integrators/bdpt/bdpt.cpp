@@ -45,14 +45,15 @@
 // filter is a box), ..._unweighted.exr (each alone estimates the depth-d image, where the strategy can
 // sample it) and ..._weight.exr (mean weight over the samples the strategy found light with).
 #include "connect_cached.h"
-#include "render_loop.h"
 #include "subpath.h"
 
 #include <penumbra/image.h>
+#include <penumbra/integrator.h>
 #include <penumbra/plugin.h>
 #include <penumbra/rng.h>
 
 #include <fmt/core.h>
+#include <tbb/enumerable_thread_specific.h>
 
 #include <map>
 
@@ -61,7 +62,16 @@ namespace {
 using namespace penumbra;
 using namespace penumbra::bdpt;
 
-// Per-strategy images for visualizestrategies / visualizeweights (double sums, one writer at a time).
+// One strategy's contribution to one pixel sample, for the strategy images.
+struct TaggedSplat {
+  int tag;
+  Vec2 p_raster;
+  Rgb weighted, unweighted;
+  float weight;
+};
+
+// Per-strategy images for visualizestrategies / visualizeweights: one set per thread (double sums),
+// added together at the end. A debugging aid: its last bits may depend on the thread count.
 class StrategyImages {
  public:
   StrategyImages(Point2i res, int max_depth) : res_(res), max_depth_(max_depth) {}
@@ -85,6 +95,18 @@ class StrategyImages {
     }
     b.weight[i] += ts.weight;
     b.count[i] += 1.0;
+  }
+
+  void merge(const StrategyImages& other) {
+    for (const auto& [tag, b] : other.buffers_) {
+      Buffers& mine = buffers_[tag];
+      if (mine.weighted.empty()) {
+        mine = b;
+        continue;
+      }
+      for (size_t i = 0; i < b.weighted.size(); ++i) mine.weighted[i] += b.weighted[i], mine.unweighted[i] += b.unweighted[i];
+      for (size_t i = 0; i < b.weight.size(); ++i) mine.weight[i] += b.weight[i], mine.count[i] += b.count[i];
+    }
   }
 
   void write(const std::string& prefix, int spp, bool strategies, bool weights) const {
@@ -138,80 +160,88 @@ uint64_t seed_of(const Sampler& proto) {
   return h;
 }
 
-class BdptIntegrator final : public Integrator {
+class BdptIntegrator final : public SampleIntegrator {
  public:
   BdptIntegrator(Config config, bool uniform_lights, bool vis_strategies, bool vis_weights, std::string prefix,
                  TechniqueSet techniques, CachedOptions cached)
       : config_(config), uniform_lights_(uniform_lights), vis_strategies_(vis_strategies),
         vis_weights_(vis_weights), prefix_(std::move(prefix)), techniques_(techniques), cached_options_(cached) {}
 
-  void render(RenderContext& rc) override {
+  void begin_render(RenderContext& rc) override {
     const Scene& scene = rc.scene();
-    LightChooser chooser(scene, uniform_lights_);
-    TechniqueSet techniques = techniques_;
-    std::unique_ptr<CachedConnector> cached;
+    res_ = rc.film().resolution();
+    chooser_ = std::make_unique<LightChooser>(scene, uniform_lights_);
+    active_ = techniques_;
     if (cached_options_.hrr || cached_options_.probconnect) {
       CachedOptions options = cached_options_;
       options.seed = seed_of(rc.sampler());
-      cached = std::make_unique<CachedConnector>(options, config_.max_depth);
-      techniques.cached = cached.get();
+      cached_ = std::make_unique<CachedConnector>(options, config_.max_depth);
+      active_.cached = cached_.get();
     }
-    Context ctx{scene, chooser, config_, techniques.all_regular() ? nullptr : &techniques};
-    bool visualize = vis_strategies_ || vis_weights_;
-    Point2i res = rc.film().resolution();
-    StrategyImages images(res, config_.max_depth);
-    int max_depth = config_.max_depth;
-    if (cached) cached->prepare(ctx, rc.sampler(), res);
+    ctx_ = std::make_unique<Context>(Context{scene, *chooser_, config_, active_.all_regular() ? nullptr : &active_});
+    visualize_ = vis_strategies_ || vis_weights_;
+    if (visualize_)
+      images_ = std::make_unique<tbb::enumerable_thread_specific<StrategyImages>>(
+          [this] { return StrategyImages(res_, config_.max_depth); });
+    if (cached_) cached_->prepare(*ctx_, rc.sampler(), res_);
+  }
 
-    auto sample = [&](Point2i pixel, uint32_t index, const CameraSample& cs, Sampler& sampler, SampleOutputs& out) {
-      thread_local std::vector<Vertex> camera_path, own_light_path;
-      camera_path.resize(max_depth + 2);
-      own_light_path.resize(max_depth + 1);
-      std::optional<Ray> ray = scene.camera().generate_ray(cs);
-      if (!ray) return Rgb(0.f);
-      PathSampler ps(sampler, pixel, index);
-      int nc = camera_subpath(ctx, *ray, ps, camera_path.data());
-      // The pixel's light subpath: from the iteration's cache when it holds it (the same path).
-      size_t j = static_cast<size_t>(pixel.y) * res.x + pixel.x;
-      const Vertex* light_path = own_light_path.data();
-      int nl;
-      if (cached && j < cached->cache().path_count()) {
-        light_path = cached->cache().path(j);
-        nl = cached->cache().path_length(j);
-      } else {
-        nl = light_subpath(ctx, ps, own_light_path.data());
-      }
-      Rgb L(0.f);
-      for (int t = 1; t <= nc; ++t)
-        for (int s = 0; s <= nl; ++s) {
-          int depth = s + t - 2;
-          if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
-          Connection c = connect(ctx, light_path, s, camera_path.data(), t, ps);
-          if (is_black(c.L)) continue;
-          if (c.splat)
-            out.splats.push_back(Splat{c.p_raster, c.weighted});
-          else
-            L += c.weighted;
-          if (visualize)
-            out.tagged.push_back(TaggedSplat{StrategyImages::tag(s, t, max_depth), c.splat ? c.p_raster : cs.p_film,
-                                             c.weighted, c.L, static_cast<float>(c.weight)});
-        }
-      if (cached)
-        for (int t = 2; t <= nc; ++t)
-          cached->connect_eye_vertex(ctx, camera_path.data(), t, pixel, index,
-                                     [&](const Connection& c, int) { L += c.weighted; });
-      return L;
-    };
-    auto commit = [&](const TaggedSplat& ts) { images.add(ts); };
-    PassOptions passes;
-    if (cached) {
-      passes.one_sample_per_pass = true;
-      passes.before_pass = [&](uint32_t index) { cached->begin_iteration(ctx, rc.sampler(), res, index); };
+  // With a light-vertex cache, a pass is one iteration: one sample per pixel over one cache.
+  int max_pass_samples() const override { return cached_ ? 1 : 16; }
+
+  void begin_pass(RenderContext& rc, const Pass& pass) override {
+    if (cached_) cached_->begin_iteration(*ctx_, rc.sampler(), res_, pass.first_index);
+  }
+
+  Rgb sample(const Scene& scene, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
+    const int max_depth = config_.max_depth;
+    thread_local std::vector<Vertex> camera_path, own_light_path;
+    camera_path.resize(max_depth + 2);
+    own_light_path.resize(max_depth + 1);
+    if (!px.ray) return Rgb(0.f);
+    PathSampler ps(sampler, px.pixel, px.index);
+    int nc = camera_subpath(*ctx_, *px.ray, ps, camera_path.data());
+    // The pixel's light subpath: from the iteration's cache when it holds it (the same path).
+    size_t j = static_cast<size_t>(px.pixel.y) * res_.x + px.pixel.x;
+    const Vertex* light_path = own_light_path.data();
+    int nl;
+    if (cached_ && j < cached_->cache().path_count()) {
+      light_path = cached_->cache().path(j);
+      nl = cached_->cache().path_length(j);
+    } else {
+      nl = light_subpath(*ctx_, ps, own_light_path.data());
     }
-    int spp = render_with_splats(rc, sample, visualize ? TaggedCommitFn(commit) : TaggedCommitFn(), passes);
-    if (visualize && spp > 0) images.write(prefix_, spp, vis_strategies_, vis_weights_);
-    if (cached) {
-      statistics_ = cached->statistics();
+    StrategyImages* images = visualize_ ? &images_->local() : nullptr;
+    Rgb L(0.f);
+    for (int t = 1; t <= nc; ++t)
+      for (int s = 0; s <= nl; ++s) {
+        int depth = s + t - 2;
+        if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
+        Connection c = connect(*ctx_, light_path, s, camera_path.data(), t, ps);
+        if (is_black(c.L)) continue;
+        if (c.splat)
+          splats.splat(c.p_raster, c.weighted);
+        else
+          L += c.weighted;
+        if (images)
+          images->add(TaggedSplat{StrategyImages::tag(s, t, max_depth), c.splat ? c.p_raster : px.camera.p_film,
+                                  c.weighted, c.L, static_cast<float>(c.weight)});
+      }
+    if (cached_)
+      for (int t = 2; t <= nc; ++t)
+        cached_->connect_eye_vertex(*ctx_, camera_path.data(), t, px.pixel, px.index,
+                                    [&](const Connection& c, int) { L += c.weighted; });
+    return L;
+  }
+
+  void end_render(RenderContext& rc, int spp) override {
+    if (visualize_ && spp > 0) {
+      StrategyImages all(res_, config_.max_depth);
+      for (const StrategyImages& part : *images_) all.merge(part);
+      all.write(prefix_, spp, vis_strategies_, vis_weights_);
+    }
+    if (cached_) {
+      statistics_ = cached_->statistics();
       built_.push_back("light_vertex_cache");
       if (cached_options_.hrr) built_.push_back("light_vertex_bvh");
       if (cached_options_.probconnect) built_.push_back("connection_cache_points");
@@ -227,6 +257,14 @@ class BdptIntegrator final : public Integrator {
   std::string prefix_;
   TechniqueSet techniques_;
   CachedOptions cached_options_;
+  // State of one render, set up in begin_render().
+  Point2i res_{0};
+  std::unique_ptr<LightChooser> chooser_;
+  TechniqueSet active_;
+  std::unique_ptr<CachedConnector> cached_;
+  std::unique_ptr<Context> ctx_;
+  bool visualize_ = false;
+  std::unique_ptr<tbb::enumerable_thread_specific<StrategyImages>> images_;
   std::vector<std::string> built_;
   std::vector<std::pair<std::string, double>> statistics_;
 };

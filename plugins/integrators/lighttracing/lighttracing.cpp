@@ -12,9 +12,9 @@
 //
 // One light path per pixel sample: the image has as many light paths as a camera-ray render has
 // camera rays, and splats are divided by the samples per pixel.
-#include "../bdpt/render_loop.h"
-#include "../bdpt/subpath.h"
+#include "subpath.h"
 
+#include <penumbra/integrator.h>
 #include <penumbra/plugin.h>
 
 namespace {
@@ -22,31 +22,35 @@ namespace {
 using namespace penumbra;
 using namespace penumbra::bdpt;
 
-class LightTracingIntegrator final : public Integrator {
+class LightTracingIntegrator final : public SampleIntegrator {
  public:
-  LightTracingIntegrator(Config config, bool uniform_lights) : config_(config), uniform_lights_(uniform_lights) {}
+  LightTracingIntegrator(Config config, bool uniform_lights) : config_(config), uniform_lights_(uniform_lights) {
+    lens_.kind = VertexKind::Camera;  // connect() only looks at the camera endpoint's kind for t = 1
+  }
 
-  void render(RenderContext& rc) override {
-    LightChooser chooser(rc.scene(), uniform_lights_);
-    Context ctx{rc.scene(), chooser, config_};
-    Vertex lens;  // connect() only looks at the camera endpoint's kind for t = 1
-    lens.kind = VertexKind::Camera;
-    render_with_splats(rc, [&](Point2i pixel, uint32_t index, const CameraSample&, Sampler& sampler, SampleOutputs& out) {
-      thread_local std::vector<Vertex> light_path;
-      light_path.resize(config_.max_depth + 1);
-      PathSampler ps(sampler, pixel, index);
-      int nl = light_subpath(ctx, ps, light_path.data());
-      for (int s = 1; s <= nl; ++s) {
-        Connection c = connect(ctx, light_path.data(), s, &lens, 1, ps, /*weighted=*/false);
-        if (c.splat && !is_black(c.L)) out.splats.push_back(Splat{c.p_raster, c.L});
-      }
-      return Rgb(0.f);
-    });
+  void begin_render(RenderContext& rc) override {
+    chooser_ = std::make_unique<LightChooser>(rc.scene(), uniform_lights_);
+    ctx_ = std::make_unique<Context>(Context{rc.scene(), *chooser_, config_});
+  }
+
+  Rgb sample(const Scene&, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
+    thread_local std::vector<Vertex> light_path;
+    light_path.resize(config_.max_depth + 1);
+    PathSampler ps(sampler, px.pixel, px.index);
+    int nl = light_subpath(*ctx_, ps, light_path.data());
+    for (int s = 1; s <= nl; ++s) {
+      Connection c = connect(*ctx_, light_path.data(), s, &lens_, 1, ps, /*weighted=*/false);
+      if (c.splat && !is_black(c.L)) splats.splat(c.p_raster, c.L);
+    }
+    return Rgb(0.f);
   }
 
  private:
   Config config_;
   bool uniform_lights_;
+  Vertex lens_;
+  std::unique_ptr<LightChooser> chooser_;
+  std::unique_ptr<Context> ctx_;
 };
 
 const ParamSpec kParams[] = {

@@ -76,16 +76,10 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
 
 }  // namespace
 
-CameraPathResult trace_camera_path(const Scene& scene, const Film& film, Sampler& sampler, Point2i pixel,
-                                   uint32_t iteration, int max_depth) {
+CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth) {
   CameraPathResult out;
-  sampler.start_pixel_sample(pixel, iteration);
-  FilterSample fs = film.sample_filter(sampler.get_pixel_2d());
-  CameraSample cs{Vec2(pixel.x + 0.5f, pixel.y + 0.5f) + fs.offset, sampler.get_2d()};
-  std::optional<Ray> camera_ray = scene.camera().generate_ray(cs);
-  if (!camera_ray) return out;
-
-  Ray ray = *camera_ray;
+  Ray ray = camera_ray;
+  float distance = 0.f;
   // The filter's weight is left out: the film normalises pixel samples by their summed weights, and
   // SPPM's single sample per pixel and iteration is drawn from the (non-negative) filter itself.
   Rgb beta(1.f);
@@ -101,6 +95,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Film& film, Sampler
       break;
     }
     if (si->area_light && count_emission) out.Ld += beta * si->area_light->L(si->p, si->ng, si->uv, si->wo);
+    distance += glm::length(si->p - ray.o);
     if (depth == max_depth) break;
 
     const Bsdf& bsdf = *si->bsdf;
@@ -120,6 +115,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Film& film, Sampler
       if (depth + 1 < max_depth) {
         out.vp = VisiblePoint{si->shading, wo, si->uv, &bsdf, beta, max_depth - 1 - depth};
         out.p = si->p;
+        out.distance = distance;
       }
       break;
     }

@@ -5,7 +5,6 @@
 #include "visible_point.h"
 
 #include <penumbra/camera.h>
-#include <penumbra/film.h>
 #include <penumbra/sampler.h>
 #include <penumbra/scene.h>
 
@@ -15,12 +14,13 @@ struct CameraPathResult {
   Rgb Ld{0.f};       // emission seen along the prefix plus direct light at its non-specular vertices
   VisiblePoint vp;   // vp.bsdf == nullptr when the path found no diffuse surface
   Vec3 p{0.f};       // the visible point's position
+  float distance = 0.f;  // length of the camera path up to the visible point
 };
 
-/// Traces sample `iteration` of `pixel`. Sampler dimensions: pixel 2, lens 2, then 10 per bounce
+/// Traces the camera path that starts with `camera_ray`; the render loop has started `sampler` at
+/// the pixel sample and drawn the pixel (2) and lens (2) dimensions. Then 10 dimensions per bounce
 /// (light 1 + 2, direct-light BSDF sample 1 + 2, continuation 1 + 2, roulette 1), drawn whether used
 /// or not so that quasi-random samplers keep their dimensions aligned across paths.
-CameraPathResult trace_camera_path(const Scene& scene, const Film& film, Sampler& sampler, Point2i pixel,
-                                   uint32_t iteration, int max_depth);
+CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth);
 
 }  // namespace penumbra::sppm

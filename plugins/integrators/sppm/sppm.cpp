@@ -8,13 +8,17 @@
 // | parameter                   | default | meaning                                                |
 // |-----------------------------|---------|--------------------------------------------------------|
 // | integer maxdepth            | 5       | longest path in bounces, camera and photon parts together |
-// | integer photonsperiteration | -1      | photons per iteration; -1: one per pixel               |
-// | float radius                | 1       | initial gather radius, world units (capped at the scene's diagonal) |
+// | integer photonsperiteration | -1      | photons per iteration; -1: one per pixel, at most 262,144 |
+// | float radius                | 0       | initial gather radius, world units; 0: from the pixel footprint |
 // | integer seed                | 0       | photon random streams (the sampler's seed drives the camera side) |
 // | float alpha                 | 2/3     | fraction of each iteration's photons kept in the count |
 //
-// Iterations are the sampler's pixel samples (--spp); with --time the render stops after the
-// iteration during which the budget ran out. An SPPM estimate is not a mean of per-iteration samples,
+// Iterations are the sampler's pixel samples (--spp), rendered by the core's loop one per pass: the
+// camera pass is the loop's pixel samples, the photon pass runs after it (end_pass). With --time the
+// photon pass stops within one batch of photons once the budget is spent (the estimate divides by
+// the photons actually emitted), and an iteration whose camera pass was cut is dropped.
+// Without a "radius", the initial radius is two pixel footprints at the median visible point of the
+// first iteration (docs/sppm.md); a given radius is used as it is, as pbrt-v4 does. An SPPM estimate is not a mean of per-iteration samples,
 // so it cannot be accumulated in the film pass by pass: it goes to the film once, at the end, and a
 // snapshot after an iteration asks the integrator for the current estimate instead.
 //
@@ -38,6 +42,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <memory>
@@ -48,7 +53,18 @@ namespace {
 using namespace penumbra;
 using namespace penumbra::sppm;
 
-class SppmIntegrator final : public Integrator {
+// The initial radius when the scene gives none: kFootprints pixel footprints (the distance between
+// the rays of neighbouring pixels, at the camera path's length) at the median visible point of the
+// first iteration. Small enough that the first iterations do not blur; wide enough that a pixel's
+// disk gathers photons from the start.
+constexpr float kFootprints = 2.f;
+// Photons per iteration by default: one per pixel, up to this many, so iterations stay short at any
+// resolution.
+constexpr uint64_t kDefaultMaxPhotons = uint64_t{1} << 18;
+// Photons traced between two looks at the time budget.
+constexpr uint64_t kPhotonBatch = 4096;
+
+class SppmIntegrator final : public SampleIntegrator {
  public:
   SppmIntegrator(int max_depth, int64_t photons_per_iteration, float radius, uint32_t seed, float alpha)
       : max_depth_(max_depth),
@@ -61,26 +77,47 @@ class SppmIntegrator final : public Integrator {
     if (grid_built_) return {"visible_point_grid"};
     return {};
   }
+  std::vector<std::pair<std::string, double>> statistics() const override { return statistics_; }
 
-  void render(RenderContext& ctx) override;
+  // One iteration per pass: the photon pass needs every pixel's visible point of that iteration.
+  int max_pass_samples() const override { return 1; }
+  bool film_holds_estimate() const override { return false; }
+  ImageRgb estimate() const override;
+
+  void begin_render(RenderContext& ctx) override;
+  Rgb sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink&) override;
+  void end_pass(RenderContext& ctx, const Pass& pass) override;
+  void end_render(RenderContext& ctx, int spp) override;
 
  private:
+  void choose_initial_radius();
+  void photon_pass(RenderContext& ctx, uint32_t iteration);
+
   int max_depth_;
   int64_t photons_per_iteration_;
-  float radius_;
+  float radius_;  // 0: from the pixel footprint
   uint32_t seed_;
   float alpha_;
   bool grid_built_ = false;
-};
+  std::vector<std::pair<std::string, double>> statistics_;
 
-// The largest gather radius worth having: a disk wider than the scene gathers every photon already,
-// and a larger one only spreads them thinner.
-float initial_radius(float radius, const Scene& scene) {
-  Bounds3 b = scene.bounds();
-  float diagonal = glm::length(b.max - b.min);
-  if (std::isfinite(diagonal) && diagonal > 0.f) return std::min(radius, diagonal);
-  return radius;
-}
+  // State of one render.
+  Point2i res_{0};
+  uint64_t photons_ = 0, photon_stream_ = 0;
+  double quantum_ = 1.0, inv_quantum_ = 1.0;
+  bool trace_photons_ = false;
+  std::vector<VisiblePoint> vps_;
+  std::vector<Vec3> vp_p_;
+  std::vector<float> vp_radius_;    // 0 where a pixel has no visible point this iteration
+  std::vector<Rgb> vp_Ld_;          // this iteration's camera-side light, kept until the pass is whole
+  std::vector<float> vp_footprint_; // first iteration only: the pixel footprint at the visible point
+  std::vector<PixelStatistics> stats_;
+  std::unique_ptr<PhotonAccumulator[]> acc_;
+  VisiblePointGrid grid_;
+  int iterations_ = 0;              // complete iterations in the statistics
+  double emitted_ = 0.0;            // photons emitted over those iterations
+  bool radius_chosen_ = false;
+};
 
 // The runtime's --seed reaches the sampler only. Folding one of the sampler's numbers into the photon
 // seed lets a new sampler seed draw new photons too.
@@ -93,138 +130,189 @@ uint64_t photon_seed(const Sampler& prototype, uint32_t seed) {
   return hash_ints(seed, bits);
 }
 
-ImageRgb estimate_image(const std::vector<PixelStatistics>& stats, Point2i res, int iterations, double photons) {
-  ImageRgb img{res.x, res.y, std::vector<float>(stats.size() * 3)};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, stats.size(), 4096), [&](const tbb::blocked_range<size_t>& b) {
+void SppmIntegrator::begin_render(RenderContext& ctx) {
+  const Scene& scene = ctx.scene();
+  res_ = ctx.film().resolution();
+  const size_t n_pixels = static_cast<size_t>(res_.x) * res_.y;
+  photons_ = photons_per_iteration_ > 0 ? static_cast<uint64_t>(photons_per_iteration_)
+                                        : std::min<uint64_t>(n_pixels, kDefaultMaxPhotons);
+  photon_stream_ = photon_seed(ctx.sampler(), seed_);
+  double total_power = 0.0;
+  for (const Light* light : scene.lights()) total_power += std::max(0.f, luminance(light->power()));
+  quantum_ = photon_quantum(total_power);
+  inv_quantum_ = 1.0 / quantum_;
+  // One bounce is all direct light; photons start to matter from two.
+  trace_photons_ = max_depth_ >= 2 && photons_ > 0 && total_power > 0.0;
+  vps_.assign(n_pixels, VisiblePoint{});
+  vp_p_.assign(n_pixels, Vec3(0.f));
+  vp_radius_.assign(n_pixels, 0.f);
+  vp_Ld_.assign(n_pixels, Rgb(0.f));
+  stats_.assign(n_pixels, PixelStatistics{});
+  acc_.reset(new PhotonAccumulator[n_pixels]);
+  radius_chosen_ = radius_ > 0.f;
+  for (PixelStatistics& st : stats_) st.radius = radius_;
+  if (!radius_chosen_) vp_footprint_.assign(n_pixels, 0.f);
+  iterations_ = 0;
+  emitted_ = 0.0;
+}
+
+// Camera pass: every pixel's state is written by the one thread that renders its sample.
+Rgb SppmIntegrator::sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink&) {
+  size_t i = static_cast<size_t>(ps.pixel.y) * res_.x + ps.pixel.x;
+  vps_[i] = VisiblePoint{};
+  vp_radius_[i] = 0.f;
+  vp_Ld_[i] = Rgb(0.f);
+  if (!ps.ray) return Rgb(0.f);
+  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_);
+  vp_Ld_[i] = r.Ld;
+  bool valid = r.vp.bsdf && is_finite(r.p) && is_finite(r.vp.beta) && !is_black(r.vp.beta);
+  if (!valid) return Rgb(0.f);
+  vps_[i] = r.vp;
+  vp_p_[i] = r.p;
+  vp_radius_[i] = static_cast<float>(stats_[i].radius);
+  if (!radius_chosen_) {
+    // The neighbouring pixel's ray through the same lens point, compared at the path's length.
+    CameraSample next = ps.camera;
+    next.p_film.x += ps.pixel.x + 1 < res_.x ? 1.f : -1.f;
+    if (std::optional<Ray> other = scene.camera().generate_ray(next)) {
+      float t = r.distance;
+      vp_footprint_[i] = glm::length((other->o + t * other->d) - (ps.ray->o + t * ps.ray->d));
+    }
+  }
+  return Rgb(0.f);
+}
+
+void SppmIntegrator::choose_initial_radius() {
+  std::vector<float> f;
+  for (size_t i = 0; i < vps_.size(); ++i)
+    if (vps_[i].bsdf && vp_footprint_[i] > 0.f && std::isfinite(vp_footprint_[i])) f.push_back(vp_footprint_[i]);
+  if (f.empty()) return;  // no visible point yet: try again at the next iteration's
+  std::nth_element(f.begin(), f.begin() + f.size() / 2, f.end());
+  float r0 = kFootprints * f[f.size() / 2];
+  for (PixelStatistics& st : stats_) st.radius = r0;
+  for (size_t i = 0; i < vps_.size(); ++i)
+    if (vps_[i].bsdf) vp_radius_[i] = r0;
+  statistics_.emplace_back("initial_radius", r0);
+  radius_chosen_ = true;
+  vp_footprint_.clear();
+  vp_footprint_.shrink_to_fit();
+}
+
+// Photon pass: each photon has its own random stream; deposits are order-independent integers.
+// Batches of photons, so a time budget that runs out stops the pass within one batch per thread.
+void SppmIntegrator::photon_pass(RenderContext& ctx, uint32_t iteration) {
+  const Scene& scene = ctx.scene();
+  std::atomic<uint64_t> traced{0};
+  const uint64_t batches = (photons_ + kPhotonBatch - 1) / kPhotonBatch;
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, batches, 1), [&](const tbb::blocked_range<uint64_t>& b) {
+    for (uint64_t batch = b.begin(); batch < b.end(); ++batch) {
+      if (ctx.should_stop()) return;
+      uint64_t k0 = batch * kPhotonBatch, k1 = std::min(photons_, k0 + kPhotonBatch);
+      for (uint64_t k = k0; k < k1; ++k) {
+        Pcg32 rng = photon_rng(photon_stream_, iteration, k);
+        trace_photon(scene, rng, max_depth_, [&](const SurfaceInteraction& hit, const Vec3& wi, const Rgb& beta, int depth) {
+          if (depth == 0) return;  // direct light: the camera pass sampled it
+          grid_.for_each_within(hit.p, [&](uint32_t i) {
+            const VisiblePoint& vp = vps_[i];
+            if (depth > vp.max_photon_depth) return;
+            Rgb phi = beta * vp.bsdf->f(vp.wo, vp.shading.to_local(wi), ShadingContext{vp.uv, TransportMode::Radiance});
+            if (!is_finite(phi)) {
+              ctx.report_nonfinite(Point2i(static_cast<int>(i % res_.x), static_cast<int>(i / res_.x)));
+              return;
+            }
+            acc_[i].add(phi, inv_quantum_);
+          });
+        });
+      }
+      traced.fetch_add(k1 - k0, std::memory_order_relaxed);
+      ctx.progress(static_cast<uint64_t>(iterations_ + 1) * vps_.size(),
+                   static_cast<uint64_t>(ctx.options().spp) * vps_.size());
+    }
+  });
+  // Photons that a cut pass did not trace were never emitted: the estimate divides by those traced.
+  emitted_ += static_cast<double>(traced.load());
+}
+
+void SppmIntegrator::end_pass(RenderContext& ctx, const Pass& pass) {
+  // A camera pass cut short by the time budget leaves some pixels without this iteration's sample:
+  // the iteration is dropped whole, so every pixel's statistics hold the same iterations.
+  if (!pass.complete) return;
+  const size_t n_pixels = vps_.size();
+  if (!radius_chosen_) choose_initial_radius();
+  bool photons_found = false;
+  if (trace_photons_ && radius_chosen_) {
+    grid_.build(vp_p_, vp_radius_);
+    grid_built_ = true;
+    // Without visible points (the camera sees only sky or glass) the photons would find nothing.
+    if (grid_.bucket_count() > 0) {
+      photon_pass(ctx, pass.first_index);
+      photons_found = true;
+    }
+  }
+  if (!photons_found && trace_photons_) emitted_ += static_cast<double>(photons_);
+  // Progressive update of N, r and tau (the visible point's throughput applies to all its photons),
+  // and the camera-side light of the whole iteration.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n_pixels, 1024), [&](const tbb::blocked_range<size_t>& b) {
     for (size_t i = b.begin(); i < b.end(); ++i) {
-      Rgb L = pixel_estimate(stats[i], iterations, photons);
+      const Rgb& Ld = vp_Ld_[i];
+      if (is_finite(Ld))
+        for (int c = 0; c < 3; ++c) stats_[i].Ld[c] += Ld[c];
+      else
+        ctx.report_nonfinite(Point2i(static_cast<int>(i % res_.x), static_cast<int>(i / res_.x)));
+      int64_t M = acc_[i].M.load(std::memory_order_relaxed);
+      if (M > 0) {
+        double Phi[3];
+        for (int c = 0; c < 3; ++c)
+          Phi[c] = static_cast<double>(acc_[i].phi[c].load(std::memory_order_relaxed)) * quantum_ * vps_[i].beta[c];
+        update_statistics(stats_[i], static_cast<double>(M), Phi, alpha_);
+        acc_[i].reset();
+      }
+    }
+  });
+  ++iterations_;
+}
+
+ImageRgb SppmIntegrator::estimate() const {
+  ImageRgb img{res_.x, res_.y, std::vector<float>(stats_.size() * 3)};
+  const double photons = trace_photons_ ? emitted_ : 0.0;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, stats_.size(), 4096), [&](const tbb::blocked_range<size_t>& b) {
+    for (size_t i = b.begin(); i < b.end(); ++i) {
+      Rgb L = iterations_ > 0 ? pixel_estimate(stats_[i], iterations_, photons) : Rgb(0.f);
       for (int c = 0; c < 3; ++c) img.pixels[3 * i + c] = L[c];
     }
   });
   return img;
 }
 
-void SppmIntegrator::render(RenderContext& ctx) {
-  const Scene& scene = ctx.scene();
+// The final estimate goes to the film once per pixel, with the iteration count as its weight, so the
+// film's weighted mean is the estimate (and `penumbra merge` weighs parts by it).
+void SppmIntegrator::end_render(RenderContext& ctx, int) {
+  if (iterations_ == 0) return;
   Film& film = ctx.film();
-  const RenderOptions& opt = ctx.options();
-  const Point2i res = film.resolution();
-  const size_t n_pixels = static_cast<size_t>(res.x) * res.y;
-  const uint64_t photons = photons_per_iteration_ > 0 ? static_cast<uint64_t>(photons_per_iteration_) : n_pixels;
-  const uint64_t photon_stream = photon_seed(ctx.sampler(), seed_);
-
-  double total_power = 0.0;
-  for (const Light* light : scene.lights()) total_power += std::max(0.f, luminance(light->power()));
-  const double quantum = photon_quantum(total_power), inv_quantum = 1.0 / quantum;
-  // One bounce is all direct light; photons start to matter from two.
-  const bool trace_photons = max_depth_ >= 2 && photons > 0 && total_power > 0.0;
-
-  std::vector<VisiblePoint> vps(n_pixels);
-  std::vector<Vec3> vp_p(n_pixels);
-  std::vector<float> vp_radius(n_pixels, 0.f);  // 0 where a pixel has no visible point this iteration
-  std::vector<PixelStatistics> stats(n_pixels);
-  std::unique_ptr<PhotonAccumulator[]> acc(new PhotonAccumulator[n_pixels]);
-  const float r0 = initial_radius(radius_, scene);
-  for (PixelStatistics& s : stats) s.radius = r0;
-  VisiblePointGrid grid;
-  auto emitted_photons = [&](int iterations) {
-    return trace_photons ? static_cast<double>(iterations) * static_cast<double>(photons) : 0.0;
-  };
-
-  tbb::enumerable_thread_specific<std::unique_ptr<Sampler>> samplers([&] { return ctx.sampler().clone(); });
-  const uint64_t progress_total = static_cast<uint64_t>(n_pixels) * static_cast<uint64_t>(opt.spp);
-
-  int done = 0;
-  while (done < opt.spp) {
-    // A part of a split render runs its own iterations [first_sample, first_sample + spp): streams
-    // independent of the other parts', so the parts are independent SPPM renders.
-    const uint32_t iteration = static_cast<uint32_t>(opt.first_sample + done);
-
-    // Camera pass: rows in parallel; every pixel's state is written by one thread only.
-    tbb::parallel_for(tbb::blocked_range<int>(0, res.y), [&](const tbb::blocked_range<int>& rows) {
-      Sampler& sampler = *samplers.local();
-      for (int y = rows.begin(); y < rows.end(); ++y)
-        for (int x = 0; x < res.x; ++x) {
-          size_t i = static_cast<size_t>(y) * res.x + x;
-          CameraPathResult r = trace_camera_path(scene, film, sampler, Point2i(x, y), iteration, max_depth_);
-          if (is_finite(r.Ld))
-            for (int c = 0; c < 3; ++c) stats[i].Ld[c] += r.Ld[c];
-          else
-            ctx.report_nonfinite(Point2i(x, y));
-          bool valid = r.vp.bsdf && is_finite(r.p) && is_finite(r.vp.beta) && !is_black(r.vp.beta);
-          vps[i] = valid ? r.vp : VisiblePoint{};
-          vp_p[i] = r.p;
-          vp_radius[i] = valid ? static_cast<float>(stats[i].radius) : 0.f;
-        }
-    });
-
-    if (trace_photons) {
-      grid.build(vp_p, vp_radius);
-      grid_built_ = true;
-    }
-    // Photon pass: each photon has its own random stream; deposits are order-independent integers.
-    // Without visible points (the camera sees only sky or glass) the photons would find nothing.
-    if (trace_photons && grid.bucket_count() > 0) {
-      tbb::parallel_for(tbb::blocked_range<uint64_t>(0, photons, 256), [&](const tbb::blocked_range<uint64_t>& b) {
-        for (uint64_t k = b.begin(); k < b.end(); ++k) {
-          Pcg32 rng = photon_rng(photon_stream, iteration, k);
-          trace_photon(scene, rng, max_depth_, [&](const SurfaceInteraction& hit, const Vec3& wi, const Rgb& beta, int depth) {
-            if (depth == 0) return;  // direct light: the camera pass sampled it
-            grid.for_each_within(hit.p, [&](uint32_t i) {
-              const VisiblePoint& vp = vps[i];
-              if (depth > vp.max_photon_depth) return;
-              Rgb phi = beta * vp.bsdf->f(vp.wo, vp.shading.to_local(wi), ShadingContext{vp.uv, TransportMode::Radiance});
-              if (!is_finite(phi)) {
-                ctx.report_nonfinite(Point2i(static_cast<int>(i % res.x), static_cast<int>(i / res.x)));
-                return;
-              }
-              acc[i].add(phi, inv_quantum);
-            });
-          });
-        }
-      });
-    }
-
-    // Progressive update of N, r and tau (the visible point's throughput applies to all its photons).
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n_pixels, 1024), [&](const tbb::blocked_range<size_t>& b) {
-      for (size_t i = b.begin(); i < b.end(); ++i) {
-        int64_t M = acc[i].M.load(std::memory_order_relaxed);
-        if (M > 0) {
-          double Phi[3];
-          for (int c = 0; c < 3; ++c)
-            Phi[c] = static_cast<double>(acc[i].phi[c].load(std::memory_order_relaxed)) * quantum * vps[i].beta[c];
-          update_statistics(stats[i], static_cast<double>(M), Phi, alpha_);
-          acc[i].reset();
-        }
-      }
-    });
-
-    ++done;
-    ctx.progress(static_cast<uint64_t>(done) * n_pixels, progress_total);
-    // The film only receives the estimate at the end; a snapshot asks for it now.
-    ctx.set_completed_spp(done, [&] { return estimate_image(stats, res, done, emitted_photons(done)); });
-    if (opt.time_budget > 0.0 && ctx.elapsed() >= opt.time_budget) break;
-  }
-
-  // The final estimate, once per pixel with the iteration count as its weight, so the film's weighted
-  // mean is the estimate.
-  ImageRgb image = estimate_image(stats, res, done, emitted_photons(done));
-  for (int y = 0; y < res.y; ++y)
-    for (int x = 0; x < res.x; ++x) {
-      const float* v = &image.pixels[3 * (static_cast<size_t>(y) * res.x + x)];
+  ImageRgb image = estimate();
+  for (int y = 0; y < res_.y; ++y)
+    for (int x = 0; x < res_.x; ++x) {
+      const float* v = &image.pixels[3 * (static_cast<size_t>(y) * res_.x + x)];
       Rgb L(v[0], v[1], v[2]);
       if (!is_finite(L)) {
         ctx.report_nonfinite(Point2i(x, y));
         L = Rgb(0.f);
       }
-      film.add_sample(Point2i(x, y), L, static_cast<float>(done));  // `penumbra merge` weighs parts by it
+      film.add_sample(Point2i(x, y), L, static_cast<float>(iterations_));
     }
+  statistics_.emplace_back("iterations", iterations_);
+  statistics_.emplace_back("photons_emitted", emitted_);
+  // Free the per-pixel state of this render.
+  vps_ = {};
+  vp_p_ = {};
+  vp_radius_ = {};
+  vp_Ld_ = {};
 }
 
 const ParamSpec kParams[] = {
     {"integer", "maxdepth", "5", "longest path in bounces, camera and photon parts together"},
-    {"integer", "photonsperiteration", "-1", "photons per iteration (-1: one per pixel)"},
-    {"float", "radius", "1", "initial gather radius in world units (capped at the scene diagonal)"},
+    {"integer", "photonsperiteration", "-1", "photons per iteration (-1: one per pixel, at most 262144)"},
+    {"float", "radius", "0", "initial gather radius in world units (0: two pixel footprints at the median visible point)"},
     {"integer", "seed", "0", "seed of the photon random streams"},
     {"float", "alpha", "0.6666667", "fraction of each iteration's photons kept in the photon count"},
 };
@@ -237,7 +325,8 @@ Object* create(const CreateContext& ctx) {
   if (photons == 0 || photons < -1)
     throw Error(p.loc_of("photonsperiteration"), "photonsperiteration must be positive (or -1: one per pixel)");
   float radius = p.get_float("radius");
-  if (!(radius > 0.f) || !std::isfinite(radius)) throw Error(p.loc_of("radius"), "radius must be positive and finite");
+  if (!(radius >= 0.f) || !std::isfinite(radius))
+    throw Error(p.loc_of("radius"), "radius must be positive and finite (or 0: from the pixel footprint)");
   float alpha = p.get_float("alpha");
   if (!(alpha > 0.f && alpha < 1.f)) throw Error(p.loc_of("alpha"), "alpha must be in (0, 1)");
   return new SppmIntegrator(max_depth, photons, radius, static_cast<uint32_t>(p.get_int("seed")), alpha);

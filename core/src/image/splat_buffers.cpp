@@ -1,0 +1,55 @@
+#include "image/splat_buffers.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace penumbra {
+
+SplatBuffers::SplatBuffers(Point2i resolution)
+    : resolution_(resolution),
+      blocks_x_((resolution.x + kBlock - 1) / kBlock),
+      blocks_y_((resolution.y + kBlock - 1) / kBlock) {}
+
+bool SplatBuffers::add(int x, int y, const Rgb& v) {
+  Fixed q[3];
+  for (int c = 0; c < 3; ++c) {
+    double s = static_cast<double>(v[c]) * kScale;
+    if (!(std::abs(s) < 0x1p120)) return false;
+    q[c] = static_cast<Fixed>(std::nearbyint(s));
+  }
+  ThreadBuffer& tb = threads_.local();
+  if (tb.blocks.empty()) tb.blocks.resize(static_cast<size_t>(blocks_x_) * blocks_y_);
+  std::unique_ptr<Block>& b = tb.blocks[static_cast<size_t>(y / kBlock) * blocks_x_ + x / kBlock];
+  if (!b) {
+    b = std::make_unique<Block>();
+    any_.store(true, std::memory_order_relaxed);
+  }
+  Fixed* p = &b->v[3 * ((y % kBlock) * kBlock + x % kBlock)];
+  for (int c = 0; c < 3; ++c) p[c] += q[c];
+  return true;
+}
+
+std::vector<double> SplatBuffers::totals() const {
+  std::vector<double> out(3 * static_cast<size_t>(resolution_.x) * resolution_.y, 0.0);
+  std::vector<Fixed> block_sum(kBlock * kBlock * 3);
+  for (int by = 0; by < blocks_y_; ++by)
+    for (int bx = 0; bx < blocks_x_; ++bx) {
+      size_t block = static_cast<size_t>(by) * blocks_x_ + bx;
+      bool touched = false;
+      std::fill(block_sum.begin(), block_sum.end(), Fixed(0));
+      for (const ThreadBuffer& tb : threads_)
+        if (!tb.blocks.empty() && tb.blocks[block]) {
+          touched = true;
+          for (size_t k = 0; k < block_sum.size(); ++k) block_sum[k] += tb.blocks[block]->v[k];
+        }
+      if (!touched) continue;
+      for (int y = by * kBlock; y < std::min((by + 1) * kBlock, resolution_.y); ++y)
+        for (int x = bx * kBlock; x < std::min((bx + 1) * kBlock, resolution_.x); ++x)
+          for (int c = 0; c < 3; ++c)
+            out[3 * (static_cast<size_t>(y) * resolution_.x + x) + c] =
+                static_cast<double>(block_sum[3 * ((y % kBlock) * kBlock + x % kBlock) + c]) / kScale;
+    }
+  return out;
+}
+
+}  // namespace penumbra

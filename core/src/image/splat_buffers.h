@@ -1,0 +1,45 @@
+// Splats from any thread, summed so that the result does not depend on which thread added what or
+// in which order: each thread adds into its own buffer (no atomics, no locks, no serial stage), in
+// 128-bit fixed point, and integer sums are exact and associative. The buffers are allocated per
+// 16x16 block on a thread's first splat into it (48 bytes per pixel and thread where it splats).
+#pragma once
+
+#include <penumbra/color.h>
+#include <penumbra/math.h>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <atomic>
+#include <memory>
+#include <vector>
+
+namespace penumbra {
+
+class SplatBuffers {
+ public:
+  explicit SplatBuffers(Point2i resolution);
+  /// Adds `v` at pixel (x, y), which must be inside the film. Returns false (and adds nothing) for
+  /// a value too large for the fixed-point range (above 2^80 in magnitude) or not finite.
+  bool add(int x, int y, const Rgb& v);
+  /// The sum of every thread's splats, 3 values per pixel, row-major.
+  std::vector<double> totals() const;
+  bool any() const { return any_.load(std::memory_order_relaxed); }
+  /// Resolution of one unit: 2^-40 (values below ~1e-12 per splat round to zero).
+  static constexpr double kScale = 0x1p40;
+
+ private:
+  static constexpr int kBlock = 16;
+  using Fixed = __int128;
+  struct Block {
+    Fixed v[kBlock * kBlock * 3] = {};
+  };
+  struct ThreadBuffer {
+    std::vector<std::unique_ptr<Block>> blocks;
+  };
+  Point2i resolution_;
+  int blocks_x_, blocks_y_;
+  mutable tbb::enumerable_thread_specific<ThreadBuffer> threads_;
+  std::atomic<bool> any_{false};
+};
+
+}  // namespace penumbra

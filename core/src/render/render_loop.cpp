@@ -1,0 +1,143 @@
+// The core's one render loop (SampleIntegrator::render): passes of samples over 16x16 tiles in
+// parallel, for every integrator. Each pixel's samples are taken in index order by one thread at a
+// time and every sample is a pure function of (pixel, index, seed), so the image is the same bit for
+// bit whatever the thread count, and a part of a split render (indices [first_sample, first_sample +
+// spp)) takes exactly its share of them. Splats go to the film's per-thread fixed-point buffers,
+// whose integer sums do not depend on the order of the additions.
+#include "render/surface_sample.h"
+
+#include <penumbra/integrator.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <memory>
+
+namespace penumbra {
+
+namespace {
+
+constexpr int kTileSize = 16;
+
+// Per-thread splat sink of one pixel sample: checks values while the pixel that made them is known.
+class CheckedSplats final : public SplatSink {
+ public:
+  CheckedSplats(RenderContext& ctx, Film& film) : ctx_(ctx), film_(film) {}
+  void start(Point2i pixel) { pixel_ = pixel; }
+  void splat(const Vec2& p_raster, const Rgb& value) override {
+    if (!is_finite(value)) {
+      ctx_.report_nonfinite(pixel_);
+      return;
+    }
+    if (!is_black(value)) film_.add_splat(p_raster, value);
+  }
+
+ private:
+  RenderContext& ctx_;
+  Film& film_;
+  Point2i pixel_{0};
+};
+
+struct ThreadState {
+  std::unique_ptr<Sampler> sampler;
+  CheckedSplats splats;
+};
+
+}  // namespace
+
+void SampleIntegrator::render(RenderContext& ctx) {
+  const Scene& scene = ctx.scene();
+  Film& film = ctx.film();
+  const Camera& camera = scene.camera();
+  const RenderOptions& opt = ctx.options();
+  const Point2i res = film.resolution();
+  const int tiles_x = (res.x + kTileSize - 1) / kTileSize, tiles_y = (res.y + kTileSize - 1) / kTileSize;
+  const uint64_t pixels = static_cast<uint64_t>(res.x) * res.y;
+  const uint64_t total = pixels * static_cast<uint64_t>(opt.spp);
+  const bool surface_aovs = film.wants_surface_samples();
+  const bool to_film = film_holds_estimate();
+
+  tbb::enumerable_thread_specific<ThreadState> threads(
+      [&] { return ThreadState{ctx.sampler().clone(), CheckedSplats(ctx, film)}; });
+
+  begin_render(ctx);
+  const int max_pass = std::max(1, max_pass_samples());  // may depend on what begin_render set up
+  std::atomic<uint64_t> samples_taken{0};  // over all passes, cut ones included
+  int done_spp = 0, pass_spp = 1;
+  while (done_spp < opt.spp && !ctx.should_stop()) {
+    Pass pass;
+    pass.first_index = static_cast<uint32_t>(opt.first_sample + done_spp);
+    pass.count = std::min({opt.spp - done_spp, pass_spp, max_pass});
+    double pass_start = ctx.elapsed();
+    begin_pass(ctx, pass);
+    std::atomic<bool> cut{false};
+    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
+      ThreadState& ts = threads.local();
+      Sampler& sampler = *ts.sampler;
+      for (int tile = r.begin(); tile < r.end(); ++tile) {
+        if (ctx.should_stop()) {
+          cut.store(true, std::memory_order_relaxed);
+          return;
+        }
+        int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
+        int x1 = std::min(x0 + kTileSize, res.x), y1 = std::min(y0 + kTileSize, res.y);
+        for (int y = y0; y < y1; ++y)
+          for (int x = x0; x < x1; ++x) {
+            Point2i pixel(x, y);
+            ts.splats.start(pixel);
+            for (int s = 0; s < pass.count; ++s) {
+              uint32_t index = pass.first_index + static_cast<uint32_t>(s);
+              sampler.start_pixel_sample(pixel, index);
+              FilterSample fs = film.sample_filter(sampler.get_pixel_2d());
+              PixelSample ps;
+              ps.pixel = pixel;
+              ps.index = index;
+              ps.camera = CameraSample{Vec2(x + 0.5f, y + 0.5f) + fs.offset, sampler.get_2d()};
+              std::optional<Ray> ray = camera.generate_ray(ps.camera);
+              ps.ray = ray ? &*ray : nullptr;
+              Rgb L = sample(scene, ps, sampler, ts.splats);
+              if (surface_aovs)
+                film.add_surface_sample(pixel, ray ? trace_surface_sample(scene, *ray, pixel, index) : SurfaceSample{},
+                                        fs.weight);
+              if (!to_film) continue;
+              if (!is_finite(L)) {
+                ctx.report_nonfinite(pixel);
+                continue;
+              }
+              film.add_sample(pixel, L, fs.weight);
+            }
+          }
+        uint64_t n = static_cast<uint64_t>(x1 - x0) * (y1 - y0) * pass.count;
+        ctx.progress(samples_taken.fetch_add(n) + n, total);
+      }
+    });
+    pass.complete = !cut.load();
+    end_pass(ctx, pass);
+    if (!pass.complete) break;
+    done_spp += pass.count;
+    double splat_spp = static_cast<double>(samples_taken.load()) / static_cast<double>(pixels);
+    if (to_film)
+      ctx.set_completed_spp(done_spp, {}, splat_spp);
+    else
+      ctx.set_completed_spp(done_spp, [this] { return estimate(); }, splat_spp);
+    if (ctx.should_stop()) break;
+    // Short passes first so a time budget is met closely, longer ones later for less overhead;
+    // with a budget, a pass never takes much more than the time that is left.
+    double now = ctx.elapsed();
+    pass_spp = std::min(pass_spp * 2, max_pass);
+    if (opt.time_budget > 0.0) {
+      double per_spp = (now - pass_start) / pass.count;
+      if (per_spp > 0.0) pass_spp = std::clamp(static_cast<int>((opt.time_budget - now) / per_spp), 1, pass_spp);
+    }
+  }
+  // A pass cut short still adds its samples: pixel means stay unbiased, and the splats are divided
+  // by the samples actually taken.
+  double splat_spp = static_cast<double>(samples_taken.load()) / static_cast<double>(pixels);
+  if (splat_spp > done_spp) ctx.set_completed_spp(done_spp, to_film ? std::function<ImageRgb()>() : [this] { return estimate(); }, splat_spp);
+  end_render(ctx, done_spp);
+}
+
+}  // namespace penumbra
