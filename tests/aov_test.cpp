@@ -164,3 +164,37 @@ TEST(FilmAovs, VarianceIsThatOfTheWeightedMean) {
   EXPECT_NEAR(layers[1].pixels[1], 4 * 5.0 / 12.0, 1e-6);
   EXPECT_EQ(layers[1].pixels[2], 0.f);
 }
+
+// Every integrator renders through the core's loop, which fills the first-hit AOVs the same way for
+// all of them: the plane's albedo, normal and depth where a pixel sees it, zeros elsewhere.
+class AovEveryIntegrator : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(AovEveryIntegrator, FirstHitLayersHoldThePlanesValues) {
+  std::string dir = test::temp_dir("aov-" + GetParam());
+  std::string scene = test::write_file(dir, "plane.pbrt", kPlaneScene);
+  test::CommandResult r = test::run_penumbra({"render", scene, "--integrator", GetParam(), "-o", dir + "/out.exr",
+                                              "--aov", "albedo,normal,depth", "--seed", "3", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  test::ExrChannels img = test::read_exr_channels(dir + "/out.exr");
+  int hits = 0;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      SCOPED_TRACE(testing::Message() << "pixel " << x << "," << y);
+      float depth = img.at("depth.Z", x, y);
+      if (std::isinf(depth)) {
+        for (const char* c : {"albedo.R", "normal.Z"}) EXPECT_EQ(img.at(c, x, y), 0.f) << c;
+        continue;
+      }
+      ++hits;
+      EXPECT_NEAR(img.at("albedo.R", x, y), 0.5f, 1e-5);
+      EXPECT_NEAR(img.at("albedo.G", x, y), 0.25f, 1e-5);
+      EXPECT_NEAR(img.at("albedo.B", x, y), 0.125f, 1e-5);
+      EXPECT_NEAR(img.at("normal.Z", x, y), 1.f, 1e-6);
+      EXPECT_GE(depth, 5.0 * (1 - 1e-6));
+      EXPECT_LE(depth, plane_depth(0, 0) * (1 + 1e-6));
+    }
+  EXPECT_EQ(hits, 32);
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, AovEveryIntegrator,
+                         ::testing::Values("path", "bdpt", "lighttracing", "sppm"));

@@ -172,14 +172,14 @@ Shape "sphere" "float radius" [ 1 ]
 // The technique combinations every agreement test runs.
 const std::vector<std::pair<std::string, std::string>>& combinations() {
   static const std::vector<std::pair<std::string, std::string>> c = {
-      {"hrr", R"("bool hrr" true)"},
+      {"hrr", R"("bool hrr" true "float hrrmaxalpha" 1)"},
       {"pc", R"("bool probconnect" true)"},
-      {"hrr+pc", R"("bool hrr" true "bool probconnect" true)"},
-      {"hrr-only-connections", R"("bool hrr" true "bool connect" false)"},
+      {"hrr+pc", R"("bool hrr" true "float hrrmaxalpha" 1 "bool probconnect" true)"},
+      {"hrr-only-connections", R"("bool hrr" true "float hrrmaxalpha" 1 "bool connect" false)"},
       {"pc-only-connections", R"("bool probconnect" true "bool connect" false)"},
-      {"hrr+pc-no-connect-no-lighttrace", R"("bool hrr" true "bool probconnect" true "bool connect" false "bool lighttrace" false)"},
-      {"hrr-balance", R"("bool hrr" true "string misheuristic" "balance")"},
-      {"hrr+pc-no-nextevent", R"("bool hrr" true "bool probconnect" true "bool nextevent" false)"},
+      {"hrr+pc-no-connect-no-lighttrace", R"("bool hrr" true "float hrrmaxalpha" 1 "bool probconnect" true "bool connect" false "bool lighttrace" false)"},
+      {"hrr-balance", R"("bool hrr" true "float hrrmaxalpha" 1 "string misheuristic" "balance")"},
+      {"hrr+pc-no-nextevent", R"("bool hrr" true "float hrrmaxalpha" 1 "bool probconnect" true "bool nextevent" false)"},
       {"hrr-glossy-only", R"("bool hrr" true "float hrrmaxalpha" 0.3)"},
   };
   return c;
@@ -190,6 +190,7 @@ const std::vector<std::pair<std::string, std::string>>& combinations() {
 TEST(BdptCached, HrrConnectionsEqualAllPairsInExpectation) {
   CachedOptions o;
   o.hrr = true;
+  o.hrr_max_alpha = 1.0;  // every eye vertex of the diffuse box
   o.hrr_target = 16;
   o.seed = 11;
   auto f = make_fixture(o);
@@ -324,7 +325,7 @@ TEST(BdptCached, CornellBoxAgreesWithPathForEveryCombination) {
 
 // One iteration's cache, BVH, records and traversals do not depend on the thread count.
 TEST(BdptCached, ImagesAreBitIdenticalOnOneAndTwoThreads) {
-  std::string file = cornell_box("threads", "Integrator \"bdpt\" \"integer maxdepth\" [ 5 ] \"bool hrr\" true "
+  std::string file = cornell_box("threads", "Integrator \"bdpt\" \"integer maxdepth\" [ 5 ] \"bool hrr\" true \"float hrrmaxalpha\" 1 "
                                             "\"bool probconnect\" true \"integer hrrconnections\" [ 8 ]");
   RenderResult one = render_file(file, 4, 3, 1), two = render_file(file, 4, 3, 2);
   ASSERT_EQ(one.image.pixels.size(), two.image.pixels.size());
@@ -333,7 +334,7 @@ TEST(BdptCached, ImagesAreBitIdenticalOnOneAndTwoThreads) {
 
 // The render stats carry the figures the benchmark reports, and the structures built are named.
 TEST(BdptCached, StatsReportConnectionsAndBvhFigures) {
-  std::string file = cornell_box("stats", "Integrator \"bdpt\" \"integer maxdepth\" [ 5 ] \"bool hrr\" true "
+  std::string file = cornell_box("stats", "Integrator \"bdpt\" \"integer maxdepth\" [ 5 ] \"bool hrr\" true \"float hrrmaxalpha\" 1 "
                                           "\"bool probconnect\" true \"integer hrrconnections\" [ 8 ]");
   RenderResult r = render_file(file, 2, 1);
   std::map<std::string, double> stats(r.stats.integrator_stats.begin(), r.stats.integrator_stats.end());
@@ -365,7 +366,7 @@ TEST(BdptCached, NoNonFiniteValuesOnBundledScenes) {
   std::sort(files.begin(), files.end());
   ASSERT_GE(files.size(), 6u);
   const std::vector<std::vector<ParamOverride>> settings = {
-      {{"hrr", "true", "test"}, {"probconnect", "true", "test"}, {"hrrconnections", "8", "test"}},
+      {{"hrr", "true", "test"}, {"hrrmaxalpha", "1", "test"}, {"probconnect", "true", "test"}, {"hrrconnections", "8", "test"}},
       {{"hrr", "true", "test"}, {"hrrmaxalpha", "0.3", "test"}, {"connect", "false", "test"}},
   };
   for (const std::string& file : files)

@@ -132,8 +132,8 @@ std::vector<Variant> variants() {
   for (const std::string& name : integrators()) {
     out.push_back({name, name, ""});
     if (name == "bdpt") {
-      out.push_back({"bdpt+hrr", name, "\"bool hrr\" true"});
-      out.push_back({"bdpt+hrr+pc", name, "\"bool hrr\" true \"bool probconnect\" true \"integer pcrecords\" 16"});
+      out.push_back({"bdpt+hrr", name, "\"bool hrr\" true \"float hrrmaxalpha\" 1"});
+      out.push_back({"bdpt+hrr+pc", name, "\"bool hrr\" true \"float hrrmaxalpha\" 1 \"bool probconnect\" true \"integer pcrecords\" 16"});
     }
   }
   return out;

@@ -225,13 +225,8 @@ void CachedConnector::calibrate(const std::vector<Vertex>& eye, const std::vecto
   }
   size_t V = cache_.vertex_count();
   C_ = 1.0;
-  if (lobes.empty() || V == 0) {
-    if (lobes.empty())
-      warning({}, fmt::format("bdpt: hrr is on, but no eye vertex of the pilot has a non-specular lobe with alpha <= "
-                              "hrrmaxalpha ({:g}): HRR will rarely or never connect in this scene",
-                              opt_.hrr_max_alpha));
-    return;
-  }
+  hrr_eligible_ = !lobes.empty();
+  if (lobes.empty() || V == 0) return;
   std::vector<Vec3> ys;
   size_t vstep = std::max<size_t>(1, V / 2048);
   for (size_t i = 0; i < V; i += vstep) ys.push_back(cache_.positions()[i]);

@@ -32,7 +32,7 @@ struct CachedOptions {
   double hrr_c = 0.0;          // C; 0: calibrate to hrr_target connections per eye vertex
   double hrr_target = 32.0;
   bool hrr_cull = true;
-  double hrr_max_alpha = 1.0;  // HRR only at eye vertices whose lobe has max(alpha) <= this
+  double hrr_max_alpha = 0.3;  // HRR only at eye vertices whose lobe has max(alpha) <= this
   bool probconnect = false;
   int pc_connections = 4;      // n_c
   int pc_records = 100;        // R
@@ -59,6 +59,8 @@ class CachedConnector final : public CachedTechniques {
   const ConnectionCache& connection_cache() const { return pc_; }
   size_t light_paths() const { return M_; }
   double hrr_c() const { return C_; }
+  /// Whether the pilot found an eye vertex where HRR may connect (a lobe within hrr_max_alpha).
+  bool hrr_eligible() const { return hrr_eligible_; }
 
   /// Every cached connection of camera vertex camera[t-1] (t >= 2); `emit` receives each one.
   void connect_eye_vertex(const Context& ctx, const Vertex* camera, int t, Point2i pixel, uint32_t index,
@@ -91,6 +93,7 @@ class CachedConnector final : public CachedTechniques {
   uint64_t id_;  // unique per connector (keys per-thread memos)
   size_t M_ = 0;
   double C_ = 0.0;
+  bool hrr_eligible_ = false;
   LightCache cache_;
   LightVertexBvh bvh_;
   ConnectionCache pc_;

@@ -27,7 +27,7 @@
 // | float hrrc               | 0       | HRR's C (area x sr); 0: calibrated to hrrconnections   |
 // | integer hrrconnections   | 32      | target mean HRR connections per eye vertex             |
 // | bool hrrcull             | true    | cull BVH nodes outside the acceptance range            |
-// | float hrrmaxalpha        | 1       | HRR only at eye lobes with roughness alpha <= this     |
+// | float hrrmaxalpha        | 0.3     | HRR only at eye lobes with roughness alpha <= this     |
 // | bool probconnect         | false   | probabilistic connections over the same cache          |
 // | integer probconnections  | 4       | draws per eye vertex (n_c)                             |
 // | integer pcrecords        | 100     | candidate light vertices per cache point               |
@@ -183,7 +183,20 @@ class BdptIntegrator final : public SampleIntegrator {
     if (visualize_)
       images_ = std::make_unique<tbb::enumerable_thread_specific<StrategyImages>>(
           [this] { return StrategyImages(res_, config_.max_depth); });
-    if (cached_) cached_->prepare(*ctx_, rc.sampler(), res_);
+    if (cached_) {
+      cached_->prepare(*ctx_, rc.sampler(), res_);
+      // HRR alone where no eye vertex may use it would only cost time (a cache, a BVH and one sample
+      // per pass): render plain bdpt instead, which samples the same paths.
+      if (cached_options_.hrr && !cached_options_.probconnect && !cached_->hrr_eligible()) {
+        warning({}, fmt::format("bdpt: hrr is on, but no eye vertex of the pilot has a non-specular lobe with "
+                                "alpha <= hrrmaxalpha ({:g}); rendering without the light-vertex cache",
+                                cached_options_.hrr_max_alpha));
+        cached_.reset();
+        active_.cached = nullptr;
+        ctx_ = std::make_unique<Context>(Context{scene, *chooser_, config_, active_.all_regular() ? nullptr : &active_});
+        built_.push_back("hrr_pilot");
+      }
+    }
   }
 
   // With a light-vertex cache, a pass is one iteration: one sample per pixel over one cache.
@@ -285,7 +298,7 @@ const ParamSpec kParams[] = {
     {"float", "hrrc", "0", "HRR's C in P = min(C q / d^2, 1); 0: calibrate to hrrconnections"},
     {"integer", "hrrconnections", "32", "target mean HRR connections per eye vertex (when hrrc is 0)"},
     {"bool", "hrrcull", "true", "cull light-vertex BVH nodes outside the acceptance range"},
-    {"float", "hrrmaxalpha", "1", "HRR only at eye vertices whose lobe roughness alpha is at most this (1: all)"},
+    {"float", "hrrmaxalpha", "0.3", "HRR only at eye vertices whose lobe roughness alpha is at most this (1: all)"},
     {"bool", "probconnect", "false", "probabilistic connections to the light-vertex cache"},
     {"integer", "probconnections", "4", "probabilistic connections per eye vertex"},
     {"integer", "pcrecords", "100", "candidate light vertices per cache point"},

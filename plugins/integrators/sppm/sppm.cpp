@@ -61,8 +61,9 @@ constexpr float kFootprints = 2.f;
 // Photons per iteration by default: one per pixel, up to this many, so iterations stay short at any
 // resolution.
 constexpr uint64_t kDefaultMaxPhotons = uint64_t{1} << 18;
-// Photons traced between two looks at the time budget.
-constexpr uint64_t kPhotonBatch = 4096;
+// Photons traced between two looks at the time budget (a photon that lands among many visible
+// points, as with a radius near the scene size, can take a millisecond).
+constexpr uint64_t kPhotonBatch = 16;
 
 class SppmIntegrator final : public SampleIntegrator {
  public:
