@@ -1,7 +1,9 @@
 // Measures, in one run on the same geometry, (1) the path tracer's whole-render ray throughput on the
 // Cornell box and (2) Embree's raw throughput for incoherent closest-hit and shadow rays with no
 // shading, and prints their ratio.
-// Usage: penumbra-bench-render [--scene FILE] [--threads N] [--spp N] [--res N]
+// Usage: penumbra-bench-render [--scene FILE] [--threads N] [--spp N] [--res N] [--rays N] [--raw-only] [--json]
+//   --raw-only  skips the path-tracer render: only raw Embree on the scene's geometry (any scene file)
+//   --json      one JSON object per thread count on stdout instead of the table
 #include "parser/scene_description.h"
 #include "registry/registry.h"
 #include "render/render_session.h"
@@ -12,12 +14,14 @@
 
 #include <embree3/rtcore.h>
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -92,18 +96,62 @@ RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
 
 int main(int argc, char** argv) {
   int spp = 32, res = 256;
+  size_t n_rays = 2'000'000;
+  bool raw_only = false, json = false;
   std::string scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
   std::vector<int> thread_counts = {1, 2};
-  for (int i = 1; i + 1 < argc; i += 2) {
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--raw-only")) { raw_only = true; continue; }
+    if (!std::strcmp(argv[i], "--json")) { json = true; continue; }
+    if (i + 1 >= argc) {
+      fmt::print(stderr, "penumbra-bench-render: {} needs a value\n", argv[i]);
+      return 2;
+    }
     if (!std::strcmp(argv[i], "--spp")) spp = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--res")) res = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--threads")) thread_counts = {std::atoi(argv[i + 1])};
     else if (!std::strcmp(argv[i], "--scene")) scene_file = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--rays")) n_rays = std::strtoull(argv[i + 1], nullptr, 10);
+    else {
+      fmt::print(stderr, "penumbra-bench-render: unknown option {}\n", argv[i]);
+      return 2;
+    }
+    ++i;
   }
   try {
     SceneDescription desc = parse_scene_file(scene_file);
     Registry registry(Registry::default_search_dirs());
     BuiltScene built = build_scene(desc, registry);
+    if (raw_only || json) {
+      for (int threads : thread_counts) {
+        nlohmann::json j;
+        j["scene"] = scene_file;
+        j["triangles"] = built.scene->triangle_count();
+        j["threads"] = threads;
+        j["rays"] = n_rays;
+        if (!raw_only) {
+          RenderSettings settings;
+          settings.scene_file = scene_file;
+          settings.spp = spp;
+          settings.resolution = std::make_pair(res, res);
+          settings.threads = threads;
+          settings.quiet = true;
+          RenderStats s = render(settings).stats;
+          j["path_mrays_per_second"] = s.mrays_per_second();
+          j["path_msamples_per_second"] = s.pixels * double(s.spp) / s.seconds * 1e-6;
+        }
+        RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
+        j["raw_closest_mrays_per_second"] = raw.closest_mrays;
+        j["raw_shadow_mrays_per_second"] = raw.shadow_mrays;
+        j["raw_mixed_mrays_per_second"] = raw.mixed_mrays;
+        if (json) fmt::print("{}\n", j.dump());
+        else
+          fmt::print("scene {}: {} triangles, {} threads: raw Embree closest-hit {:.2f}, shadow {:.2f}, mixed {:.2f} Mrays/s\n",
+                     scene_file, built.scene->triangle_count(), threads, raw.closest_mrays, raw.shadow_mrays,
+                     raw.mixed_mrays);
+      }
+      return 0;
+    }
     fmt::print("scene {}: {} triangles\n", scene_file, built.scene->triangle_count());
     fmt::print("{:>7} {:>14} {:>14} {:>14} {:>14} {:>12} {:>8}\n", "threads", "path Mrays/s", "Msamples/s",
                "raw hit Mr/s", "raw shad Mr/s", "raw mix Mr/s", "ratio");
@@ -117,7 +165,7 @@ int main(int argc, char** argv) {
       RenderResult r = render(settings);
       const RenderStats& s = r.stats;
       double msamples = s.pixels * double(s.spp) / s.seconds * 1e-6;
-      RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), 2'000'000, threads);
+      RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
       fmt::print("{:>7} {:>14.2f} {:>14.3f} {:>14.2f} {:>14.2f} {:>12.2f} {:>7.1f}%\n", threads,
                  s.mrays_per_second(), msamples, raw.closest_mrays, raw.shadow_mrays, raw.mixed_mrays,
                  100.0 * s.mrays_per_second() / raw.mixed_mrays);

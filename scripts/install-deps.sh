@@ -10,6 +10,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-matplotlib python3-numpy
+  git python3   # bench/integrators.sh: commit hash in its history, table and CSV (standard library only)
   clang-14 libclang-rt-14-dev
 )
 

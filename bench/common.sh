@@ -1,0 +1,38 @@
+# Helpers shared by bench/integrators.sh and bench/make-references.sh (sourced).
+
+# Short commit hash, "+dirty" when tracked files differ from it (the benchmark's own results and
+# references under bench/results/ and bench/references/ do not count).
+bench_commit() {
+  local root="$1" hash
+  hash=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
+  if [ "$hash" != unknown ] && [ -n "$(git -C "$root" status --porcelain --untracked-files=no -- . \
+      ':(exclude)bench/results' ':(exclude)bench/references' 2>/dev/null)" ]; then
+    hash="$hash+dirty"
+  fi
+  echo "$hash"
+}
+
+bench_cpu_model() {
+  local m
+  m=$(awk -F': *' '/^model name/ { print $2; exit }' /proc/cpuinfo 2>/dev/null)
+  [ -n "$m" ] || m=$(uname -m)
+  echo "$m"
+}
+
+bench_loadavg() { cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo ""; }
+
+# The build's binaries; exits with a hint when they are missing.
+bench_find_build() {
+  local build="$1" b
+  for b in penumbra penumbra-bench-image-errors penumbra-bench-render; do
+    if [ ! -x "$build/bin/$b" ]; then
+      echo "missing $build/bin/$b; build first: cmake -B build -G Ninja -DCMAKE_BUILD_TYPE=Release && cmake --build build -j2" >&2
+      exit 1
+    fi
+  done
+}
+
+# Python with the interpreter the project's scripts use (Debian's, where python3-matplotlib lives).
+bench_python() {
+  if [ -x /usr/bin/python3 ]; then echo /usr/bin/python3; else echo python3; fi
+}

@@ -1,0 +1,38 @@
+# Benchmark scenes of bench/integrators.sh and bench/make-references.sh (sourced by both).
+# One line per scene: short name, scene file (relative to the repository), reference integrator.
+# The reference integrator is path tracing, except where path tracing cannot sample some of the
+# light: through the glass sphere a point light's caustic is a specular path ending on a delta light,
+# which only light tracing (bdpt's t = 1 strategy) renders.
+BENCH_SCENE_TABLE="
+cornell-spheres-area   scenes/bench/cornell-spheres-area.pbrt   path
+cornell-spheres-point  scenes/bench/cornell-spheres-point.pbrt  bdpt
+cornell-spheres-env    scenes/bench/cornell-spheres-env.pbrt    path
+cornell-box            scenes/cornell-box/scene.pbrt            path
+cornell-water          bench/scenes/cornell-water-diffuse.pbrt  path
+"
+
+bench_scene_names() { awk 'NF == 3 { print $1 }' <<<"$BENCH_SCENE_TABLE"; }
+bench_scene_file() { awk -v n="$1" '$1 == n { print $2 }' <<<"$BENCH_SCENE_TABLE"; }
+bench_scene_reference_integrator() { awk -v n="$1" '$1 == n { print $3 }' <<<"$BENCH_SCENE_TABLE"; }
+
+# Parameters every render of a benchmark scene gets with this integrator (besides the scene's own).
+# SPPM's gather radius is passed here rather than in the scene files: 0.01 world units (the scenes
+# are 2 to 2.6 units across); its default is being changed elsewhere.
+bench_integrator_params() {
+  case "$1" in
+    sppm) echo "--param radius=0.01" ;;
+    *) echo "" ;;
+  esac
+}
+
+# Checks a comma-separated scene list; prints the names one a line.
+bench_check_scenes() {
+  local list="$1" s
+  for s in ${list//,/ }; do
+    if [ -z "$(bench_scene_file "$s")" ]; then
+      echo "unknown scene '$s'; the benchmark scenes are: $(bench_scene_names | tr '\n' ' ')" >&2
+      return 1
+    fi
+    echo "$s"
+  done
+}
