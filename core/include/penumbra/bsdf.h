@@ -35,6 +35,8 @@ struct BsdfSample {
   Vec3 wi{0.f};        // sampled incident direction, local frame
   float pdf = 0.f;     // solid-angle density (specular: the discrete probability of the lobe)
   uint32_t flags = 0;  // lobe that was sampled (BsdfFlags)
+  float eta = 1.f;     // transmission: relative IOR eta' across the interface as wo sees it (radiance
+                       // is scaled by 1/eta'^2 there; path tracers undo it for Russian roulette)
   bool is_specular() const { return (flags & BsdfSpecular) != 0; }
 };
 

@@ -27,6 +27,7 @@ EmbreeScene::~EmbreeScene() {
 
 void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
                            std::vector<const Light*> lights) {
+  mesh->finish();
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                         RTC_FORMAT_FLOAT3, 3 * sizeof(float),
@@ -133,12 +134,12 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   if (g.mesh) {
     // The hit point comes from the barycentrics: its error does not grow with t.
     Vec3 b(1.f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v);
-    si.p = g.mesh->position(rh.hit.primID, b);
-    si.p_error = g.mesh->position_error(rh.hit.primID, b);
-    si.ng = g.mesh->geometric_normal(rh.hit.primID, b);
-    Vec3 ns = g.mesh->shading_normal(rh.hit.primID, b);
-    si.ns = ns == Vec3(0.f) ? si.ng : ns;
-    si.uv = g.mesh->uv_at(rh.hit.primID, b);
+    TriangleMesh::Surface s = g.mesh->surface(rh.hit.primID, b);
+    si.p = s.p;
+    si.p_error = s.p_error;
+    si.ng = s.ng;
+    si.ns = s.ns;
+    si.uv = s.uv;
   } else {
     si.p = g.sphere->reproject(ray.o + si.t * ray.d);
     si.p_error = error_gamma(5) * glm::abs(si.p);

@@ -23,12 +23,46 @@ Vec3 TriangleMesh::shading_normal(size_t i, const Vec3& b) const {
   return len2 > 0.f ? n / std::sqrt(len2) : Vec3(0.f);
 }
 
-Vec3 TriangleMesh::geometric_normal(size_t i, const Vec3& b) const {
+void TriangleMesh::finish() {
+  face_normals.resize(triangle_count());
+  for (size_t i = 0; i < face_normals.size(); ++i) {
+    const uint32_t* v = &indices[3 * i];
+    face_normals[i] = glm::normalize(glm::cross(P[v[0]] - P[v[2]], P[v[1]] - P[v[2]]));
+  }
+}
+
+Vec3 TriangleMesh::face_normal(size_t i) const {
+  if (i < face_normals.size()) return face_normals[i];
   const uint32_t* v = &indices[3 * i];
-  Vec3 n = glm::normalize(glm::cross(P[v[0]] - P[v[2]], P[v[1]] - P[v[2]]));
-  Vec3 ns = shading_normal(i, b);
+  return glm::normalize(glm::cross(P[v[0]] - P[v[2]], P[v[1]] - P[v[2]]));
+}
+
+// pbrt's orientation: towards the shading normal when the mesh has one, else by the winding.
+Vec3 TriangleMesh::oriented(const Vec3& n, const Vec3& ns) const {
   if (ns != Vec3(0.f)) return glm::dot(n, ns) < 0.f ? -n : n;
   return flip_normal ? -n : n;
+}
+
+Vec3 TriangleMesh::geometric_normal(size_t i, const Vec3& b) const {
+  return oriented(face_normal(i), shading_normal(i, b));
+}
+
+TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
+  const uint32_t* v = &indices[3 * i];
+  const Vec3 &p0 = P[v[0]], &p1 = P[v[1]], &p2 = P[v[2]];
+  Surface s;
+  s.p = b.x * p0 + b.y * p1 + b.z * p2;
+  s.p_error = error_gamma(7) * (glm::abs(b.x * p0) + glm::abs(b.y * p1) + glm::abs(b.z * p2));
+  Vec3 ns(0.f);
+  if (!N.empty()) {
+    Vec3 n = b.x * N[v[0]] + b.y * N[v[1]] + b.z * N[v[2]];
+    float len2 = glm::dot(n, n);
+    if (len2 > 0.f) ns = n / std::sqrt(len2);
+  }
+  s.ng = oriented(face_normal(i), ns);
+  s.ns = ns == Vec3(0.f) ? s.ng : ns;
+  s.uv = uv.empty() ? Vec2(b.y + b.z, b.z) : b.x * uv[v[0]] + b.y * uv[v[1]] + b.z * uv[v[2]];
+  return s;
 }
 
 Vec2 TriangleMesh::uv_at(size_t i, const Vec3& b) const {

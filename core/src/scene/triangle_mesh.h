@@ -13,6 +13,10 @@ struct TriangleMesh {
   std::vector<Vec2> uv;      // optional
   std::vector<uint32_t> indices;
   bool flip_normal = false;  // ReverseOrientation xor a handedness-swapping transform (used without N)
+  std::vector<Vec3> face_normals;  // unit normals by the winding (finish() fills them)
+
+  /// Computes what hits need per triangle (the face normals); call once the mesh is complete.
+  void finish();
 
   size_t triangle_count() const { return indices.size() / 3; }
   /// Geometric normal of triangle i, oriented by pbrt's rules (towards N when given, else by the
@@ -24,6 +28,17 @@ struct TriangleMesh {
   /// Error bound of position(): gamma_7 (|b0 p0| + |b1 p1| + |b2 p2|) per component (pbrt-v3).
   Vec3 position_error(size_t i, const Vec3& b) const;
   float area(size_t i) const;
+
+  /// Everything a hit at barycentrics b of triangle i needs, with the vertex indices read once.
+  struct Surface {
+    Vec3 p, p_error, ng, ns;  // ns: the interpolated N, or ng without N
+    Vec2 uv;
+  };
+  Surface surface(size_t i, const Vec3& b) const;
+
+ private:
+  Vec3 face_normal(size_t i) const;
+  Vec3 oriented(const Vec3& n, const Vec3& ns) const;
 };
 
 class Triangle final : public Shape {

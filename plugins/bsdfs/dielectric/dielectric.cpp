@@ -72,7 +72,7 @@ class DielectricBsdf final : public Bsdf {
     float ft = distrib_.D(wm) * distrib_.G(wo, wi) * T * std::abs(dot_i * dot_o / (denom * wi.z * wo.z));
     if (ctx.mode == TransportMode::Radiance) ft /= sqr(etap);
     if (!(pdf > 0.f) || !std::isfinite(pdf)) return std::nullopt;
-    return BsdfSample{Rgb(ft), wi, pdf, BsdfTransmission | BsdfGlossy};
+    return BsdfSample{Rgb(ft), wi, pdf, BsdfTransmission | BsdfGlossy, etap};
   }
 
   float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
@@ -124,7 +124,7 @@ class DielectricBsdf final : public Bsdf {
     if (!refract(wo, Vec3(0.f, 0.f, 1.f), eta_, &etap, &wi) || wi.z == 0.f) return std::nullopt;
     float ft = T / std::abs(wi.z);
     if (ctx.mode == TransportMode::Radiance) ft /= sqr(etap);
-    return BsdfSample{Rgb(ft), wi, T, BsdfTransmission | BsdfSpecular};
+    return BsdfSample{Rgb(ft), wi, T, BsdfTransmission | BsdfSpecular, etap};
   }
 
   // The microfacet normal that scatters wo into wi, with what kind of event it is.

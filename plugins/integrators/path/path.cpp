@@ -11,6 +11,9 @@
 // Depth convention (pbrt's): a path of depth d has d scattering events between camera and emitter,
 // so maxdepth D sums the series L_e + ... + (throughput)^D L_e exactly.
 //
+// Russian roulette (after rrdepth bounces) continues with probability min(1, max component of the
+// throughput times the product of eta'^2 of the refractions so far), as pbrt-v4 does.
+//
 // Sample dimensions per bounce are fixed (light choice 1, light point 2, BSDF lobe 1, BSDF
 // direction 2, roulette 1), so quasi-random samplers see the same dimension at every depth.
 #include <penumbra/integrator.h>
@@ -31,6 +34,7 @@ class PathIntegrator final : public PixelIntegrator {
     Ray ray = camera_ray;
     bool specular_bounce = false;
     float bsdf_pdf = 0.f;            // density of the direction that produced `ray`
+    float eta_scale = 1.f;           // product of eta'^2 over the refractions so far
     LightSampleContext prev_ctx;     // the vertex that produced `ray`
 
     for (int depth = 0;; ++depth) {
@@ -89,11 +93,14 @@ class PathIntegrator final : public PixelIntegrator {
       beta *= bs->f * std::abs(bs->wi.z) / bs->pdf;
       specular_bounce = bs->is_specular();
       bsdf_pdf = bs->pdf;
+      if (bs->flags & BsdfTransmission) eta_scale *= sqr(bs->eta);
       prev_ctx = LightSampleContext{si->p, si->ng};
       ray = si->spawn_ray(wi);
 
+      // Roulette on the throughput without the 1/eta'^2 of refractions (pbrt-v4's etaScale): radiance
+      // compressed inside glass is not less important, and would otherwise be ended too often.
       if (depth + 1 >= rr_depth_) {
-        float q = std::max(0.f, 1.f - max_component(beta));
+        float q = std::max(0.f, 1.f - max_component(beta * eta_scale));
         if (u_rr < q) break;
         beta /= 1.f - q;
       }
