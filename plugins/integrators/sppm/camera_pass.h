@@ -19,7 +19,8 @@ struct CameraPathResult {
 
 /// Traces sample `iteration` of `pixel`. Sampler dimensions: pixel 2, lens 2, then 10 per bounce
 /// (light 1 + 2, direct-light BSDF sample 1 + 2, continuation 1 + 2, roulette 1), drawn whether used
-/// or not so that quasi-random samplers keep their dimensions aligned across paths.
+/// or not so that quasi-random samplers keep their dimensions aligned across paths. A visible point
+/// on a BSDF with delta and diffuse lobes draws 3 more per extra BSDF sample after the last bounce's.
 CameraPathResult trace_camera_path(const Scene& scene, const Film& film, Sampler& sampler, Point2i pixel,
                                    uint32_t iteration, int max_depth);
 
