@@ -6,6 +6,7 @@
 #include "support/pcg32.h"
 
 #include <penumbra/error.h>
+#include <penumbra/microfacet.h>
 
 #include <gtest/gtest.h>
 
@@ -35,16 +36,17 @@ struct ChiCase {
 // Every lobe appears at least once: diffuse + retro (roughness), sheen, anisotropic specular,
 // metal, clearcoat at several glosses, rough transmission at eta 1.5 and 2.5, the eta ~ 1
 // pass-through, and the thin-surface lobes (fake subsurface, diffuse and thin transmission).
-// Roughness 0.01 hits the alpha clamp (1e-3).
+// Roughness 0.032 is the narrowest glossy lobe (alpha 1.024e-3, just above
+// TrowbridgeReitz::kSmoothAlpha; below it the lobes are deltas, tested further down).
 const ChiCase kChiCases[] = {
-    {R"("float metallic" [1] "float roughness" [0.01])", 0.012f},
+    {R"("float metallic" [1] "float roughness" [0.032])", 0.012f},
     {R"("float metallic" [1] "float roughness" [0.3])"},
     {R"("float metallic" [1] "float roughness" [1])"},
     {R"("float metallic" [1] "float roughness" [0.3] "float anisotropic" [0.8] "rgb color" [0.9 0.6 0.2])"},
     {R"("float metallic" [1] "float roughness" [1] "float anisotropic" [0.8])"},
     {R"("float roughness" [0.3] "rgb color" [0.8 0.3 0.2])"},
     {R"("float roughness" [1] "float sheen" [1] "float sheentint" [1] "rgb color" [0.2 0.5 0.8])"},
-    {R"("float roughness" [0.01])", 0.012f},
+    {R"("float roughness" [0.032])", 0.012f},
     {R"("float metallic" [0.5] "float roughness" [0.3] "float speculartint" [1] "float anisotropic" [0.8])"},
     {R"("float roughness" [0.5] "float clearcoat" [1] "float clearcoatgloss" [0])"},
     {R"("float metallic" [1] "float roughness" [0.3] "float clearcoat" [1] "float clearcoatgloss" [0.5])"},
@@ -53,7 +55,7 @@ const ChiCase kChiCases[] = {
     {R"("float spectrans" [1] "float eta" [1.5] "float roughness" [0.3] "rgb color" [1 1 1])"},
     {R"("float spectrans" [1] "float eta" [2.5] "float roughness" [0.3] "rgb color" [0.9 0.9 0.7])"},
     {R"("float spectrans" [1] "float eta" [1.5] "float roughness" [1])"},
-    {R"("float spectrans" [1] "float eta" [1.5] "float roughness" [0.01])", 0.012f},
+    {R"("float spectrans" [1] "float eta" [1.5] "float roughness" [0.032])", 0.012f},
     {R"("float spectrans" [0.5] "float eta" [1.0001] "float roughness" [0.3])", 0.f, false},
     {R"("float spectrans" [1] "float eta" [1.5] "float roughness" [0.3] "float anisotropic" [0.8])"},
     {R"("float spectrans" [0.5] "float eta" [1.5] "float roughness" [0.5] "float clearcoat" [1] "float clearcoatgloss" [0.2] "float sheen" [1])"},
@@ -210,7 +212,7 @@ double max_albedo(const Bsdf& bsdf, const std::string& what, double bound, Trans
 }  // namespace
 
 TEST(DisneyBsdf, WhiteFurnaceMetalAndCoatConserveEnergy) {
-  for (const char* r : {"0.01", "0.3", "1"}) {
+  for (const char* r : {"0.01", "0.032", "0.3", "1"}) {
     auto metal = make_bsdf("disney", std::string(R"("rgb color" [1 1 1] "float metallic" [1] "float roughness" [)") + r + "]");
     max_albedo(*metal, std::string("metal roughness ") + r, 1.0, TransportMode::Radiance);
   }
@@ -233,7 +235,7 @@ TEST(DisneyBsdf, WhiteFurnaceTransmissionConservesEnergy) {
   // Importance transport integrates the BSDF over its second argument, the direction light leaves
   // to: that is the energy balance for both sides. Radiance from outside is lower by 1/eta^2 for
   // the transmitted part (and higher from inside, so no bound there).
-  for (const char* r : {"0.01", "0.3", "1"}) {
+  for (const char* r : {"0.01", "0.032", "0.3", "1"}) {
     std::string params = std::string(R"("rgb color" [1 1 1] "float spectrans" [1] "float eta" [1.5] "float roughness" [)") + r + "]";
     auto glass = make_bsdf("disney", params);
     max_albedo(*glass, "glass (importance) roughness " + std::string(r), 1.0, TransportMode::Importance);
@@ -438,4 +440,304 @@ TEST(CoatedDiffuse, WarnsAndSamplesItsOwnPdf) {
   ChiSquareResult c = bsdf_chi_square(*rough, spherical_direction(0.05f, 2.f), kChiSamples, 33);
   for (const ChiSquareResult* r : {&a, &b, &c}) EXPECT_TRUE(r->passes(alpha)) << r->summary();
   std::printf("  [coateddiffuse] p = %.3f %.3f %.3f\n", a.p_value, b.p_value, c.p_value);
+}
+
+// ---- Smooth lobes are deltas (TrowbridgeReitz::kSmoothAlpha, shared with conductor and dielectric) --
+
+namespace {
+
+// Above, grazing, at the pole and below (two-sided metal; the inside of glass).
+const Vec3 kDeltaDirections[] = {spherical_direction(1.f, 0.f),    spherical_direction(0.8f, 0.3f),
+                                 spherical_direction(0.3f, 2.f),   spherical_direction(0.02f, 4.f),
+                                 spherical_direction(-0.6f, 1.1f), spherical_direction(-0.9f, 5.f),
+                                 spherical_direction(-1.f, 0.f)};
+
+Rgb weight_of(const BsdfSample& s) { return s.f * std::abs(s.wi.z) / s.pdf; }
+// Largest component of |a - b| (Rgb and Vec3 are the same type).
+float max_difference(const Vec3& a, const Vec3& b) {
+  Vec3 d = glm::abs(a - b);
+  return std::max({d.x, d.y, d.z});
+}
+double schlick(double r0, double cos_theta) { return r0 + (1.0 - r0) * std::pow(1.0 - cos_theta, 5.0); }
+
+// f() and pdf() of a BSDF made of delta lobes only are 0 for any pair of directions, the delta's own
+// direction included.
+void expect_no_density(const Bsdf& bsdf, const Vec3& wo, const Vec3& delta_direction, const std::string& what) {
+  Pcg32 rng(5);
+  for (int i = 0; i < 64; ++i) {
+    Vec3 wi = i == 0 ? delta_direction : spherical_direction(2.f * rng.next_float() - 1.f, 2.f * Pi * rng.next_float());
+    for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+      ShadingContext ctx;
+      ctx.mode = mode;
+      EXPECT_EQ(bsdf.f(wo, wi, ctx), Rgb(0.f)) << what << " wo.z=" << wo.z << " wi.z=" << wi.z;
+      EXPECT_EQ(bsdf.pdf(wo, wi, ctx), 0.f) << what << " wo.z=" << wo.z << " wi.z=" << wi.z;
+    }
+  }
+}
+
+// Forwards to a real BSDF, with every sample's weight scaled: a 2 % bias the furnace check must see.
+class ScaledWeight final : public Bsdf {
+ public:
+  ScaledWeight(const Bsdf& bsdf, float scale) : b_(bsdf), scale_(scale) {}
+  uint32_t flags() const override { return b_.flags(); }
+  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& c) const override { return b_.f(wo, wi, c); }
+  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& c) const override {
+    std::optional<BsdfSample> s = b_.sample_f(wo, uc, u, c);
+    if (s) s->f *= scale_;
+    return s;
+  }
+  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& c) const override { return b_.pdf(wo, wi, c); }
+  LobeSummary lobe(const Vec3& wo, const ShadingContext& c) const override { return b_.lobe(wo, c); }
+
+ private:
+  const Bsdf& b_;
+  float scale_;
+};
+
+}  // namespace
+
+TEST(DisneyBsdf, SmoothThresholdIsConductorsOnBothAxesAfterAnisotropy) {
+  // alpha = roughness^2, stretched to alpha / aspect and alpha * aspect (aspect = sqrt(1 - 0.9 aniso)).
+  struct Case {
+    const char* params;
+    bool delta;
+  };
+  const Case cases[] = {
+      {R"("float metallic" [1] "float roughness" [0])", true},
+      {R"("float metallic" [1] "float roughness" [0.0316])", true},    // alpha 9.99e-4
+      {R"("float metallic" [1] "float roughness" [0.032])", false},    // alpha 1.024e-3
+      {R"("float metallic" [1] "float roughness" [0.01] "float anisotropic" [1])", true},   // 3.2e-4, 3.2e-5
+      {R"("float metallic" [1] "float roughness" [0.02] "float anisotropic" [1])", false},  // 1.26e-3 along s
+  };
+  for (const Case& c : cases) {
+    auto bsdf = make_bsdf("disney", c.params);
+    EXPECT_EQ(bsdf->flags(), uint32_t(BsdfReflection | (c.delta ? BsdfSpecular : BsdfGlossy))) << c.params;
+    EXPECT_EQ(bsdf->is_specular_only(), c.delta) << c.params;
+    std::optional<BsdfSample> s = bsdf->sample_f(spherical_direction(0.7f, 0.2f), 0.5f, Vec2(0.3f, 0.6f), kRadiance);
+    ASSERT_TRUE(s) << c.params;
+    EXPECT_EQ(s->is_specular(), c.delta) << c.params;
+  }
+  EXPECT_EQ(TrowbridgeReitz::kSmoothAlpha, 1e-3f);
+}
+
+TEST(DisneyBsdf, SmoothMetalIsTheConductorMirror) {
+  // A white metal against conductor's near-perfect mirror (eta 1, k 1e4: F = 1 - O(1e-8) at every
+  // angle, as Schlick's F with R0 = 1 is exactly): same directions, same weights.
+  auto disney = make_bsdf("disney", R"("rgb color" [1 1 1] "float metallic" [1] "float roughness" [0])");
+  auto mirror = make_bsdf("conductor", R"("rgb eta" [1 1 1] "rgb k" [10000 10000 10000] "float roughness" [0])");
+  // A coloured metal against conductor with the same reflectance at normal incidence: Disney's
+  // Fresnel is Schlick's from R0 = color, conductor's the exact one of eta 1 and k from R0, so the
+  // weights agree at normal incidence and each follows its own Fresnel elsewhere.
+  const Rgb r0(0.9f, 0.6f, 0.3f);
+  auto disney_c = make_bsdf("disney", R"("rgb color" [0.9 0.6 0.3] "float metallic" [1] "float roughness" [0])");
+  auto copperish = make_bsdf("conductor", R"("rgb reflectance" [0.9 0.6 0.3] "float roughness" [0])");
+  for (const Bsdf* b : {disney.get(), mirror.get(), disney_c.get(), copperish.get()})
+    EXPECT_EQ(b->flags(), uint32_t(BsdfReflection | BsdfSpecular));
+
+  Pcg32 rng(41);
+  float worst_direction = 0.f, worst_weight = 0.f, worst_schlick = 0.f, largest_model_gap = 0.f;
+  for (const Vec3& wo : kDeltaDirections) {
+    const Vec3 reflected(-wo.x, -wo.y, wo.z);
+    expect_no_density(*disney, wo, reflected, "disney metal");
+    expect_no_density(*disney_c, wo, reflected, "disney coloured metal");
+    for (int i = 0; i < 16; ++i) {
+      float uc = rng.next_float();
+      Vec2 u(rng.next_float(), rng.next_float());
+      ShadingContext ctx;
+      ctx.mode = i % 2 ? TransportMode::Importance : TransportMode::Radiance;
+      std::optional<BsdfSample> a = disney->sample_f(wo, uc, u, ctx), b = mirror->sample_f(wo, uc, u, ctx);
+      std::optional<BsdfSample> c = disney_c->sample_f(wo, uc, u, ctx), d = copperish->sample_f(wo, uc, u, ctx);
+      ASSERT_TRUE(a && b && c && d) << "wo.z=" << wo.z;
+      for (const BsdfSample* s : {&*a, &*b, &*c, &*d}) {
+        EXPECT_EQ(s->flags, uint32_t(BsdfReflection | BsdfSpecular)) << "wo.z=" << wo.z;
+        EXPECT_EQ(s->pdf, 1.f) << "wo.z=" << wo.z;  // the only lobe
+        worst_direction = std::max(worst_direction, max_difference(s->wi, reflected));
+      }
+      worst_weight = std::max(worst_weight, max_difference(weight_of(*a), weight_of(*b)));
+      Rgb expected_schlick(schlick(r0.r, std::abs(wo.z)), schlick(r0.g, std::abs(wo.z)), schlick(r0.b, std::abs(wo.z)));
+      worst_schlick = std::max(worst_schlick, max_difference(weight_of(*c), expected_schlick));
+      if (std::abs(wo.z) == 1.f) {
+        EXPECT_LT(max_difference(weight_of(*c), weight_of(*d)), 1e-5f) << "normal incidence, wo.z=" << wo.z;
+        EXPECT_LT(max_difference(weight_of(*d), r0), 1e-5f);
+      }
+      largest_model_gap = std::max(largest_model_gap, max_difference(weight_of(*c), weight_of(*d)));
+    }
+  }
+  std::printf("  [mirror] direction error %.2g, weight vs conductor %.2g, coloured weight vs Schlick %.2g; "
+              "Schlick vs exact conductor Fresnel (same R0) up to %.3f off normal incidence\n",
+              worst_direction, worst_weight, worst_schlick, largest_model_gap);
+  EXPECT_LT(worst_direction, 1e-6f);
+  EXPECT_LT(worst_weight, 1e-5f);
+  EXPECT_LT(worst_schlick, 1e-5f);
+}
+
+TEST(DisneyBsdf, SmoothGlassIsTheDielectric) {
+  auto disney = make_bsdf("disney", R"("rgb color" [1 1 1] "float spectrans" [1] "float eta" [1.5] "float roughness" [0])");
+  auto glass = make_bsdf("dielectric", R"("float eta" [1.5] "float roughness" [0])");
+  const uint32_t kFlags = BsdfReflection | BsdfTransmission | BsdfSpecular;
+  EXPECT_EQ(disney->flags(), kFlags);
+  EXPECT_EQ(glass->flags(), kFlags);
+  float worst_direction = 0.f, worst_weight = 0.f, worst_probability = 0.f;
+  int refractions = 0, total_internal = 0;
+  for (const Vec3& wo : kDeltaDirections) {
+    for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+      ShadingContext ctx;
+      ctx.mode = mode;
+      // uc = 0 picks reflection in both; uc just below 1 refraction, unless there is none (total
+      // internal reflection, where both reflect with probability 1).
+      for (float uc : {0.f, 0.999999f}) {
+        std::optional<BsdfSample> a = disney->sample_f(wo, uc, Vec2(0.4f, 0.7f), ctx);
+        std::optional<BsdfSample> b = glass->sample_f(wo, uc, Vec2(0.4f, 0.7f), ctx);
+        ASSERT_TRUE(a && b) << "wo.z=" << wo.z << " uc=" << uc;
+        EXPECT_EQ(a->flags, b->flags) << "wo.z=" << wo.z << " uc=" << uc;
+        EXPECT_TRUE(a->is_specular());
+        worst_direction = std::max(worst_direction, max_difference(a->wi, b->wi));
+        worst_weight = std::max(worst_weight, max_difference(weight_of(*a), weight_of(*b)));
+        worst_probability = std::max(worst_probability, std::abs(a->pdf - b->pdf));
+        if (uc > 0.f) (a->flags & BsdfTransmission ? refractions : total_internal) += 1;
+        expect_no_density(*disney, wo, a->wi, "disney glass");
+      }
+    }
+  }
+  std::printf("  [glass] direction error %.2g, weight error %.2g, lobe probability error %.2g (%d refractions, "
+              "%d total internal reflections)\n",
+              worst_direction, worst_weight, worst_probability, refractions, total_internal);
+  EXPECT_LT(worst_direction, 1e-5f);
+  EXPECT_LT(worst_weight, 1e-5f);
+  EXPECT_LT(worst_probability, 1e-5f);
+  EXPECT_GT(refractions, 0);
+  EXPECT_GT(total_internal, 0);  // wo.z = -0.6 is past the critical angle (cos 0.745) from inside
+
+  // Thin: the refraction is a straight pass-through of weight 1 - F, picked with probability 1 - F
+  // (throughput exactly 1 in both modes: the two interfaces undo each other's radiance scaling).
+  auto thin = make_bsdf("disney", R"("bool thin" [true] "rgb color" [1 1 1] "float spectrans" [1] "float eta" [1.5] "float roughness" [0])");
+  EXPECT_EQ(thin->flags(), kFlags);
+  for (const Vec3& wo : kDeltaDirections) {
+    float eta = wo.z > 0.f ? 1.5f : 1.f / 1.5f;
+    float T = 1.f - fresnel_dielectric(std::abs(wo.z), eta);
+    for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+      ShadingContext ctx;
+      ctx.mode = mode;
+      std::optional<BsdfSample> s = thin->sample_f(wo, 0.999999f, Vec2(0.5f), ctx);
+      ASSERT_TRUE(s);
+      if (T == 0.f) {
+        EXPECT_EQ(s->flags, uint32_t(BsdfReflection | BsdfSpecular));
+        continue;
+      }
+      EXPECT_EQ(s->flags, uint32_t(BsdfTransmission | BsdfSpecular)) << "wo.z=" << wo.z;
+      EXPECT_EQ(s->wi, -wo);
+      EXPECT_NEAR(s->pdf, T, 1e-5f) << "wo.z=" << wo.z;
+      EXPECT_LT(max_difference(weight_of(*s), Rgb(1.f)), 1e-5f) << "wo.z=" << wo.z;
+      expect_no_density(*thin, wo, -wo, "thin disney glass");
+    }
+  }
+}
+
+// A delta next to other lobes: sample_f picks among all of them, f() and pdf() describe the others
+// only (so the chi-square of the non-delta samples against pdf() must pass, and the pdf integrates to
+// the share of non-delta samples), flags() has Specular and the others' bits.
+TEST(DisneyBsdf, MixedDeltaAndOtherLobesSampleTheirPdf) {
+  const char* kMixed[] = {
+      R"("float metallic" [0.5] "float roughness" [0])",
+      R"("float roughness" [0.01] "rgb color" [0.8 0.3 0.2])",  // plastic: the dielectric part is a mirror
+      R"("float metallic" [1] "float roughness" [0] "float clearcoat" [1] "float clearcoatgloss" [0.5])",
+      R"("float spectrans" [0.5] "float eta" [1.5] "float roughness" [0])",
+      R"("bool thin" [true] "float spectrans" [0.5] "float roughness" [0] "float flatness" [0.5] "float difftrans" [1])",
+  };
+  constexpr int kCases = sizeof(kMixed) / sizeof(kMixed[0]);
+  constexpr int kDirs = sizeof(kChiDirections) / sizeof(kChiDirections[0]);
+  const double alpha = sidak_alpha(0.01, kCases * kDirs);
+  std::vector<std::unique_ptr<Bsdf>> bsdfs;
+  for (const char* p : kMixed) {
+    bsdfs.push_back(make_bsdf("disney", p));
+    uint32_t f = bsdfs.back()->flags();
+    EXPECT_TRUE(f & BsdfSpecular) << p;
+    EXPECT_TRUE(f & (BsdfDiffuse | BsdfGlossy)) << p;
+    EXPECT_FALSE(bsdfs.back()->is_specular_only()) << p;
+  }
+  std::vector<ChiSquareResult> results(kCases * kDirs);
+  parallel_for(kCases * kDirs, [&](int i) {
+    BsdfChiSquareOptions options;
+    options.max_refinements = std::abs(kChiDirections[i % kDirs].z) < 0.1f ? 4 : 2;
+    results[i] = bsdf_chi_square(*bsdfs[i / kDirs], kChiDirections[i % kDirs], kChiSamples, 2000 + i, options);
+  });
+  for (int i = 0; i < kCases * kDirs; ++i) {
+    const ChiSquareResult& r = results[i];
+    const Vec3& wo = kChiDirections[i % kDirs];
+    std::printf("  [mixed chi2] p=%.4f pdf_integral=%.4f delta+declined=%.4f cos_o=%+.2f %s\n", r.p_value,
+                r.pdf_integral, r.invalid_fraction, wo.z, kMixed[i / kDirs]);
+    EXPECT_TRUE(r.passes(alpha)) << kMixed[i / kDirs] << " wo.z=" << wo.z << ": " << r.summary();
+    EXPECT_NEAR(r.pdf_integral, 1.0 - r.invalid_fraction, 0.01) << kMixed[i / kDirs] << " wo.z=" << wo.z;
+    EXPECT_GT(r.invalid_fraction, 0.01) << "the delta lobe is sampled: " << kMixed[i / kDirs];
+    PdfConsistency c = pdf_consistency(*bsdfs[i / kDirs], wo, 100'000);  // the coat case samples its coat 2 % of the time
+    EXPECT_GT(c.checked, 1000) << kMixed[i / kDirs];
+    EXPECT_LT(c.max_pdf_error, 1e-4) << kMixed[i / kDirs] << " wo.z=" << wo.z;
+    EXPECT_LT(c.max_f_error, 1e-4) << kMixed[i / kDirs] << " wo.z=" << wo.z;
+  }
+}
+
+TEST(DisneyBsdf, MixedMirrorAndDiffuseFurnaceMatchesClosedForm) {
+  // White base, metallic 0.5, roughness 0, eta 1.5: a mirror of weight
+  //   F(c) = 0.5 F_dielectric(c, 1.5) + 0.5 Schlick(R0 = lerp(0.04, 1, 0.5) = 0.52, c)
+  // plus Burley's diffuse 0.5 (1 - Fo/2)(1 - Fi/2)/pi (no retro-reflection at roughness 0), whose
+  // albedo is 0.5 (1 - Fo/2)(1 - 1/42), Fo = (1 - c)^5, since 2 int_0^1 (1 - mu)^5 mu dmu = 1/21.
+  // The estimate must match that within 4 standard errors from its own sample variance, and a 2 %
+  // bias in the weights must not. Disney adds diffuse and specular without coupling them, so at
+  // grazing angles the albedo exceeds 1 (1.11 at cos 0.05, the closed form says so too); up to
+  // cos 0.2 it stays below 1.
+  auto bsdf = make_bsdf("disney", R"("rgb color" [1 1 1] "float metallic" [0.5] "float roughness" [0])");
+  ScaledWeight biased(*bsdf, 1.02f);
+  auto expected = [](double c) {
+    double fo = std::pow(1.0 - c, 5.0);
+    double mirror = 0.5 * fresnel_dielectric(float(c), 1.5f) + 0.5 * schlick(0.52, c);
+    return mirror + 0.5 * (1.0 - 0.5 * fo) * (1.0 - 1.0 / 42.0);
+  };
+  constexpr int kSamples = 400'000;
+  for (float c : {1.f, 0.7f, 0.4f, 0.2f, 0.05f, -0.5f}) {
+    Vec3 wo = spherical_direction(c, 0.8f);
+    double truth = expected(std::abs(c));
+    for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+      AlbedoEstimate e = albedo_estimate(*bsdf, wo, kSamples, 77, mode);
+      AlbedoEstimate b = albedo_estimate(biased, wo, kSamples, 77, mode);
+      EXPECT_EQ(e.non_finite, 0);
+      for (int ch = 0; ch < 3; ++ch) {
+        double z = (e.mean[ch] - truth) / e.standard_error[ch];
+        double z_biased = (b.mean[ch] - truth) / b.standard_error[ch];
+        if (ch == 0)
+          std::printf("  [mixed furnace] cos %+.2f: %.5f +- %.5f, closed form %.5f (z = %+.2f; 2 %% biased: z = %+.1f)\n",
+                      c, e.mean[ch], e.standard_error[ch], truth, z, z_biased);
+        EXPECT_LT(std::abs(z), 4.0) << "cos " << c << " channel " << ch;
+        EXPECT_GT(std::abs(z_biased), 4.0) << "the check must catch a 2 % bias: cos " << c;
+        if (std::abs(c) >= 0.2f) {
+          EXPECT_LE(e.mean[ch], 1.0 + 4.0 * e.standard_error[ch]) << "cos " << c;
+        }
+      }
+    }
+  }
+}
+
+TEST(DisneyBsdf, LobeSummaryLeavesDeltasOutWhenThereAreOtherLobes) {
+  Vec3 wo = spherical_direction(0.6f, 0.5f);
+  Vec3 reflected(-wo.x, -wo.y, wo.z);
+  // A mirror that would dominate (weight ~0.9) next to a faint diffuse: connections only see the diffuse.
+  auto mostly_mirror = make_bsdf("disney", R"("rgb color" [1 1 1] "float metallic" [0.9] "float roughness" [0])");
+  LobeSummary l = mostly_mirror->lobe(wo, kRadiance);
+  EXPECT_TRUE(l.cosine);
+  EXPECT_NEAR(l.coefficient, 0.1f, 1e-3f);
+  // Mirror + clear coat: the coat's GTR1 lobe.
+  auto coated = make_bsdf("disney", R"("float metallic" [1] "float roughness" [0] "float clearcoat" [1] "float clearcoatgloss" [0.5])");
+  l = coated->lobe(wo, kRadiance);
+  EXPECT_FALSE(l.cosine);
+  EXPECT_NEAR(l.alpha_x, 0.0505f, 1e-5f);
+  EXPECT_LT(glm::distance(l.peak, reflected), 1e-5f);
+  // Deltas only: the strongest delta, narrower than the threshold, as conductor reports its mirror.
+  auto metal = make_bsdf("disney", R"("float metallic" [1] "float roughness" [0])");
+  l = metal->lobe(wo, kRadiance);
+  EXPECT_FALSE(l.cosine);
+  EXPECT_LT(glm::distance(l.peak, reflected), 1e-5f);
+  EXPECT_LT(std::max(l.alpha_x, l.alpha_y), TrowbridgeReitz::kSmoothAlpha);
+  auto glass = make_bsdf("disney", R"("float spectrans" [1] "float roughness" [0] "float eta" [1.5])");
+  l = glass->lobe(wo, kRadiance);
+  EXPECT_LT(std::max(l.alpha_x, l.alpha_y), TrowbridgeReitz::kSmoothAlpha);
+  EXPECT_NEAR(std::sqrt(1.f - sqr(l.peak.z)), std::sqrt(1.f - sqr(wo.z)) / 1.5f, 1e-4f);  // refracted
 }

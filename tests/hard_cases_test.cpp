@@ -73,6 +73,10 @@ AttributeEnd
            {"disney-roughness-1e-4", "Material \"disney\" \"float roughness\" [ 0.0001 ]"},
            {"disney-roughness-1", "Material \"disney\" \"float roughness\" [ 1 ] \"float sheen\" [ 1 ]"},
            {"disney-metal-mirror", "Material \"disney\" \"float metallic\" [ 1 ] \"float roughness\" [ 0 ]"},
+           // Deltas next to other lobes: mirror + diffuse, smooth glass + diffuse, thin pass-through.
+           {"disney-mirror-on-diffuse", "Material \"disney\" \"float metallic\" [ 0.5 ] \"float roughness\" [ 0 ]"},
+           {"disney-glass-roughness-0", "Material \"disney\" \"float spectrans\" [ 0.5 ] \"float roughness\" [ 0 ]"},
+           {"disney-thin-roughness-0", "Material \"disney\" \"bool thin\" [ true ] \"float spectrans\" [ 0.5 ] \"float roughness\" [ 0 ] \"float difftrans\" [ 1 ]"},
            {"disney-glass-eta-1", "Material \"disney\" \"float spectrans\" [ 1 ] \"float eta\" [ 1 ] \"float roughness\" [ 0 ]"},
            {"disney-glass-eta-1.0001", "Material \"disney\" \"float spectrans\" [ 1 ] \"float eta\" [ 1.0001 ] \"float roughness\" [ 0.0001 ]"},
            {"dielectric-eta-1", "Material \"dielectric\" \"float eta\" [ 1 ]"},

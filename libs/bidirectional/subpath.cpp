@@ -113,7 +113,9 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     Rgb scatter = bs->f * std::abs(bs->wi.z) / bs->pdf;
     if (mode == TransportMode::Importance) scatter *= shading_correction(v, v.wo, wi);
     beta *= scatter;
-    // A specular choice generates both neighbours with a delta: their densities stay 0.
+    // A specular choice generates both neighbours with a delta: their densities stay 0. The flag is
+    // the sample's, not the BSDF's: a mixed BSDF (delta + diffuse) is delta only where it sampled its
+    // delta, and stays connectible through its other lobes (connectible(), mis_weight()).
     v.delta = bs->is_specular();
 
     if (added >= ctx.config.rr_depth) {

@@ -44,6 +44,9 @@ struct BsdfSample {
 /// where a BSDF sends most of its energy: an anisotropic GGX-like lobe around `peak` (local frame)
 /// with roughness (alpha_x, alpha_y) along the shading frame's s and t axes, scaled by `coefficient`
 /// (an albedo-like weight). A diffuse lobe reports peak = +z (on wo's side), alpha = 1, cosine = true.
+/// It describes what connections can use: a BSDF with delta lobes among others summarises the
+/// others (f() and pdf() leave deltas out); one of delta lobes only reports its strongest delta, with
+/// alphas below TrowbridgeReitz::kSmoothAlpha, which no connection uses (the vertex is not connectible).
 struct LobeSummary {
   Vec3 peak{0.f, 0.f, 1.f};
   float alpha_x = 1.f, alpha_y = 1.f;
@@ -54,7 +57,9 @@ struct LobeSummary {
 class Bsdf : public Object {
  public:
   ~Bsdf() override;
-  /// Union of the lobes this BSDF can have (BsdfFlags).
+  /// Union of the lobes this BSDF can have (BsdfFlags). A delta lobe among others adds BsdfSpecular
+  /// next to their bits: such a BSDF is not specular-only (integrators connect to it through f() and
+  /// pdf() of the other lobes) and its delta samples carry BsdfSpecular in BsdfSample::flags.
   virtual uint32_t flags() const = 0;
   virtual Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const = 0;
   /// Samples wi given wo; uc picks a lobe, u the direction. Empty when no direction was produced.

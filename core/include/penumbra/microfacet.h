@@ -23,7 +23,7 @@ namespace penumbra {
 /// alpha_x and alpha_y are the roughnesses along the shading frame's s (x) and t (y) axes.
 class TrowbridgeReitz {
  public:
-  /// Alphas are clamped to at least 1e-4 so that D and Lambda stay finite; smaller values are a
+  /// Alphas are clamped to at least 1e-4 so that D and Lambda stay finite; such values are a
   /// delta lobe anyway (see effectively_smooth()).
   TrowbridgeReitz(float alpha_x, float alpha_y)
       : alpha_x_(std::max(alpha_x, kMinAlpha)), alpha_y_(std::max(alpha_y, kMinAlpha)) {}
@@ -34,8 +34,17 @@ class TrowbridgeReitz {
   float alpha_x() const { return alpha_x_; }
   float alpha_y() const { return alpha_y_; }
 
+  /// The smoothness threshold every microfacet BSDF shares (conductor, dielectric, disney): a lobe
+  /// whose alpha is below kSmoothAlpha along both axes is so narrow that sampling and evaluating it
+  /// as a density is hopeless in float (D reaches 1 / (pi alpha^2) ~ 3e5 and next-event estimation
+  /// through it produces fireflies), so it is a delta instead: a perfect mirror (f = F / |cos|,
+  /// pdf = the lobe's selection probability, flags Specular) or a perfect refraction, and f() and
+  /// pdf() of that lobe are 0 for given directions. GTR1 (Disney's clearcoat) is not a
+  /// TrowbridgeReitz lobe and does not use it.
+  static constexpr float kSmoothAlpha = 1e-3f;
+
   /// So narrow that sampling and evaluating it as a lobe is hopeless in float: treat as a delta.
-  bool effectively_smooth() const { return std::max(alpha_x_, alpha_y_) < 1e-3f; }
+  bool effectively_smooth() const { return std::max(alpha_x_, alpha_y_) < kSmoothAlpha; }
 
   /// Normal distribution D(wm), normalised so that the projected microfacet area integrates to 1:
   /// int D(wm) cos(theta_m) dwm = 1. Symmetric in wm -> -wm, so callers may pass either orientation.

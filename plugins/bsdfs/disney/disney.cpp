@@ -8,13 +8,13 @@
 // | rgb color            | 0.5 0.5 0.5 | base colour, each channel in [0, 1]                          |
 // | float metallic       | 0           | 0 dielectric .. 1 metal (specular coloured by `color`)       |
 // | float eta            | 1.5         | IOR of the dielectric part (specular Fresnel, transmission)  |
-// | float roughness      | 0.5         | alpha = roughness^2, at least 1e-3 (0 is a very sharp lobe)  |
+// | float roughness      | 0.5         | alpha = roughness^2; below 1e-3 (both axes): a delta, see notes |
 // | float speculartint   | 0           | tints the Schlick R0 towards the colour's hue                |
 // | float anisotropic    | 0           | stretches the highlight along the shading frame's s axis     |
 // | float sheen          | 0           | grazing-angle sheen for cloth                                |
 // | float sheentint      | 0.5         | tints the sheen towards the colour's hue                     |
 // | float clearcoat      | 0           | weight of the clear coat (0.25 clearcoat, IOR 1.5)           |
-// | float clearcoatgloss | 1           | coat GTR1 alpha = lerp(0.1, 0.001, clearcoatgloss)           |
+// | float clearcoatgloss | 1           | coat GTR1 alpha = lerp(0.1, 0.001, clearcoatgloss), never a delta |
 // | float spectrans      | 0           | share of the dielectric part that refracts                   |
 // | bool thin            | false       | thin surface: one-lobe transmission, flatness, difftrans     |
 // | float flatness       | 0           | thin only: blends diffuse into the fake subsurface lobe      |
@@ -23,6 +23,19 @@
 // Notes: speculartint only shows where metallic is between 0 and 1 (the dielectric part uses the
 // exact dielectric Fresnel, as in pbrt-v3). Within 1e-3 of eta = 1 transmission is a straight
 // pass-through (a delta lobe).
+//
+// Smooth lobes are deltas, with conductor's and dielectric's threshold (TrowbridgeReitz::
+// kSmoothAlpha = 1e-3 in penumbra/microfacet.h): where the specular alpha (roughness^2, stretched by
+// anisotropic) is below 1e-3 along both axes (roughness below ~0.0316 when isotropic), the specular
+// reflection, metallic and dielectric parts together, is a perfect mirror; where the transmission
+// alpha is (the same, or for thin surfaces ((0.65 eta - 0.35) roughness)^2), transmission is a
+// perfect refraction, and for thin surfaces a straight pass-through of weight 1 - F without the
+// 1/eta^2 of entering a medium (it is left again at once). pbrt-v3 instead clamps alpha to 1e-3
+// and keeps a GGX lobe there, which next-event estimation turns into fireflies. "metallic 1
+// roughness 0" is thus conductor's mirror with Schlick's Fresnel from `color`, and "spectrans 1
+// roughness 0 color 1" is dielectric's smooth glass. Other lobes stay what they are: a mirror
+// on a diffuse base (metallic 0.5, roughness 0) is a delta plus a diffuse lobe. The clearcoat
+// is never a delta: GTR1's alpha is at least 0.001 by its definition (clearcoatgloss 1).
 #include "disney_bsdf.h"
 
 #include <penumbra/plugin.h>
@@ -37,7 +50,7 @@ const ParamSpec kParams[] = {
     {"rgb", "color", "0.5 0.5 0.5", "base colour, each channel in [0, 1]"},
     {"float", "metallic", "0", "0 dielectric .. 1 metal"},
     {"float", "eta", "1.5", "index of refraction of the dielectric part"},
-    {"float", "roughness", "0.5", "0 smooth .. 1 rough; alpha = roughness^2 (at least 1e-3)"},
+    {"float", "roughness", "0.5", "0 smooth .. 1 rough; alpha = roughness^2, a perfect mirror/refraction below alpha 1e-3"},
     {"float", "speculartint", "0", "tints the Schlick specular colour towards the base hue (shows for 0 < metallic < 1)"},
     {"float", "anisotropic", "0", "0 isotropic .. 1 highlight stretched along the tangent"},
     {"float", "sheen", "0", "grazing-angle sheen (cloth)"},

@@ -14,14 +14,18 @@ constexpr float kPassThroughEtaTolerance = 1e-3f;
 
 TrowbridgeReitz disney_distribution(float roughness, float aspect) {
   // Burley: alpha = roughness^2 (not the sqrt remap of pbrt-v4's other materials), stretched by
-  // the aspect ratio for anisotropy.
+  // the aspect ratio for anisotropy. No clamp of Burley's (pbrt-v3's alpha >= 1e-3): below
+  // TrowbridgeReitz::kSmoothAlpha on both axes the lobe is a delta (effectively_smooth()).
   float a = sqr(roughness);
-  return TrowbridgeReitz(std::max(kMinAlpha, a / aspect), std::max(kMinAlpha, a * aspect));
+  return TrowbridgeReitz(a / aspect, a * aspect);
 }
+
+// What a delta lobe reports as its alpha in the lobe summary: the distribution's floor.
+float delta_alpha() { return TrowbridgeReitz(0.f, 0.f).alpha_x(); }
 
 }  // namespace
 
-DisneyBsdf::DisneyBsdf(const DisneyParams& p) : eta_(p.eta) {
+DisneyBsdf::DisneyBsdf(const DisneyParams& p) : eta_(p.eta), thin_(p.thin) {
   const Rgb& c = p.color;
   float lum = luminance(c);
   Rgb tint = lum > 0.f ? c / lum : Rgb(1.f);  // hue and saturation only
@@ -55,11 +59,13 @@ DisneyBsdf::DisneyBsdf(const DisneyParams& p) : eta_(p.eta) {
       p.thin ? disney_distribution((0.65f * p.eta - 0.35f) * p.roughness, aspect) : specular_.distribution;
   transmissive_ = !is_black(transmission_.tint);
   pass_through_ = std::abs(p.eta - 1.f) < kPassThroughEtaTolerance;
+  specular_delta_ = specular_.distribution.effectively_smooth();
+  transmission_delta_ = pass_through_ || transmission_.distribution.effectively_smooth();
 
   if (diffuse_.active()) flags_ |= BsdfReflection | BsdfDiffuse;
-  if (specular_.active(eta_) || clearcoat_.active()) flags_ |= BsdfReflection | BsdfGlossy;
-  if (rough_transmission()) flags_ |= BsdfTransmission | BsdfGlossy;
-  if (transmissive_ && pass_through_) flags_ |= BsdfTransmission | BsdfSpecular;
+  if (specular_.active(eta_)) flags_ |= BsdfReflection | (specular_delta_ ? BsdfSpecular : BsdfGlossy);
+  if (clearcoat_.active()) flags_ |= BsdfReflection | BsdfGlossy;
+  if (transmissive_) flags_ |= BsdfTransmission | (transmission_delta_ ? BsdfSpecular : BsdfGlossy);
   if (!is_black(diffuse_transmission_)) flags_ |= BsdfTransmission | BsdfDiffuse;
 }
 
@@ -80,8 +86,9 @@ DisneyBsdf::Weights DisneyBsdf::weights(const Side& side) const {
   if (clearcoat_.active()) w.clearcoat = clearcoat_.weight * fresnel_schlick(clearcoat_.r0, cos_o);
   if (transmissive_) {
     float t = 1.f - fresnel_dielectric(cos_o, side.eta);
-    // Past the critical angle rough facets still refract some light: keep sampling them.
-    w.transmission = luminance(transmission_.tint) * (pass_through_ ? t : std::max(t, 0.1f));
+    // Past the critical angle rough facets still refract some light: keep sampling them. A delta
+    // refracts exactly 1 - F (nothing under total internal reflection).
+    w.transmission = luminance(transmission_.tint) * (transmission_delta_ ? t : std::max(t, 0.1f));
   }
   if (!is_black(diffuse_transmission_)) w.diffuse_transmission = std::max(luminance(diffuse_transmission_), 1e-3f);
   return w;
@@ -92,7 +99,7 @@ Rgb DisneyBsdf::f_upper(const Side& side, const Vec3& wi, TransportMode mode) co
   if (wi.z > 0.f) {
     Rgb r(0.f);
     if (diffuse_.active()) r += diffuse_.f(wo, wi);
-    if (specular_.active(eta_)) r += specular_.f(wo, wi, side.eta);
+    if (rough_specular()) r += specular_.f(wo, wi, side.eta);
     if (clearcoat_.active()) r += Rgb(clearcoat_.f(wo, wi));
     return r;
   }
@@ -108,7 +115,7 @@ float DisneyBsdf::pdf_upper(const Side& side, const Weights& w, const Vec3& wi) 
   float p = 0.f;
   if (wi.z > 0.f) {
     if (w.diffuse > 0.f) p += w.diffuse * cosine_hemisphere_pdf(wi.z);
-    if (w.specular > 0.f) p += w.specular * specular_.pdf(wo, wi);
+    if (w.specular > 0.f && !specular_delta_) p += w.specular * specular_.pdf(wo, wi);
     if (w.clearcoat > 0.f) p += w.clearcoat * clearcoat_.pdf(wo, wi);
   } else {
     if (w.diffuse_transmission > 0.f) p += w.diffuse_transmission * cosine_hemisphere_pdf(-wi.z);
@@ -156,6 +163,13 @@ std::optional<BsdfSample> DisneyBsdf::sample_f(const Vec3& wo, float uc, Vec2 u,
       sampled = BsdfReflection | BsdfDiffuse;
       break;
     case Specular:
+      if (specular_delta_) {
+        // A mirror, as conductor's: f = F / |cos| and pdf the lobe's probability, so that
+        // f |cos| / pdf = F / p. The half vector is the normal: Fresnel at cos_o.
+        Vec3 mirror(-side.wo.x, -side.wo.y, side.wo.z);
+        Rgb f = specular_.fresnel(side.wo.z, side.eta) / side.wo.z;
+        return BsdfSample{f, side.to_upper(mirror), w.specular / sum, BsdfReflection | BsdfSpecular};
+      }
       wi = specular_.sample(side.wo, u);
       sampled = BsdfReflection | BsdfGlossy;
       break;
@@ -164,11 +178,20 @@ std::optional<BsdfSample> DisneyBsdf::sample_f(const Vec3& wo, float uc, Vec2 u,
       sampled = BsdfReflection | BsdfGlossy;
       break;
     case Transmission:
-      if (pass_through_) {
-        // A delta: f is its weight and pdf the lobe's probability, so f |cos| / pdf is the throughput.
-        Rgb f = transmission_.tint * (1.f - fresnel_dielectric(side.wo.z, side.eta)) / side.wo.z;
-        if (ctx.mode == TransportMode::Radiance) f /= sqr(side.eta);
-        return BsdfSample{f, -wo, w.transmission / sum, BsdfTransmission | BsdfSpecular};
+      if (transmission_delta_) {
+        // A delta, as dielectric's smooth refraction: f = (1 - F) tint / |cos_i| and pdf the lobe's
+        // probability. Straight through for eta ~ 1 and for thin surfaces (two parallel interfaces
+        // give the direction back, and the radiance compression of entering is undone on leaving,
+        // so thin surfaces do not scale by 1/eta^2); otherwise refracted about the normal.
+        float T = 1.f - fresnel_dielectric(side.wo.z, side.eta);
+        Vec3 wt = -side.wo;
+        float etap = side.eta;
+        if (!pass_through_ && !thin_ && !refract(side.wo, Vec3(0.f, 0.f, 1.f), side.eta, &etap, &wt))
+          return std::nullopt;  // total internal reflection: T = 0, never chosen
+        if (!(T > 0.f) || wt.z == 0.f) return std::nullopt;
+        Rgb f = transmission_.tint * (T / std::abs(wt.z));
+        if (ctx.mode == TransportMode::Radiance && !thin_) f /= sqr(etap);
+        return BsdfSample{f, side.to_upper(wt), w.transmission / sum, BsdfTransmission | BsdfSpecular};
       }
       wi = transmission_.sample(side.wo, u, side.eta);
       sampled = BsdfTransmission | BsdfGlossy;
@@ -195,7 +218,14 @@ LobeSummary DisneyBsdf::lobe(const Vec3& wo, const ShadingContext&) const {
   Side side = side_of(wo);
   Weights w = weights(side);
   float diffuse = w.diffuse + w.diffuse_transmission;
-  float best = std::max({diffuse, w.specular, w.clearcoat, w.transmission});
+  // Delta lobes are left out when there are others: connections (the summary's users) only see f()
+  // of the non-delta lobes. A BSDF of delta lobes only describes its strongest delta, as conductor
+  // and dielectric do for theirs.
+  bool has_non_delta = diffuse > 0.f || w.clearcoat > 0.f || (w.specular > 0.f && !specular_delta_) ||
+                       (w.transmission > 0.f && !transmission_delta_);
+  float specular = has_non_delta && specular_delta_ ? 0.f : w.specular;
+  float transmission = has_non_delta && transmission_delta_ ? 0.f : w.transmission;
+  float best = std::max({diffuse, specular, w.clearcoat, transmission});
   const Vec3 up(0.f, 0.f, 1.f);
   if (best == diffuse) {
     l.coefficient = diffuse;
@@ -204,17 +234,17 @@ LobeSummary DisneyBsdf::lobe(const Vec3& wo, const ShadingContext&) const {
   l.cosine = false;
   l.coefficient = best;
   Vec3 peak = reflect(side.wo, up);
-  if (best == w.specular) {
+  if (best == specular) {
     l.alpha_x = specular_.distribution.alpha_x();
     l.alpha_y = specular_.distribution.alpha_y();
   } else if (best == w.clearcoat) {
     l.alpha_x = l.alpha_y = clearcoat_.alpha;
   } else {
-    l.alpha_x = pass_through_ ? kMinAlpha : transmission_.distribution.alpha_x();
-    l.alpha_y = pass_through_ ? kMinAlpha : transmission_.distribution.alpha_y();
+    l.alpha_x = pass_through_ ? delta_alpha() : transmission_.distribution.alpha_x();
+    l.alpha_y = pass_through_ ? delta_alpha() : transmission_.distribution.alpha_y();
     Vec3 refracted;
     float etap;
-    if (pass_through_) peak = -side.wo;
+    if (pass_through_ || (thin_ && transmission_delta_)) peak = -side.wo;
     else if (refract(side.wo, up, side.eta, &etap, &refracted)) peak = refracted;
   }
   l.peak = side.to_upper(peak);

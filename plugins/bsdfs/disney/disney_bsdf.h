@@ -3,6 +3,19 @@
 // the given wo. f() is the sum of all lobes and pdf() the exact mixture sum_k p_k pdf_k, the
 // one-sample MIS density of what sample_f() does.
 //
+// Smooth lobes are deltas, with the threshold conductor and dielectric use
+// (TrowbridgeReitz::kSmoothAlpha): when the specular distribution's alpha is below it along both
+// axes (after anisotropy), the specular reflection (metallic and dielectric part together) is a
+// mirror; when the transmission distribution's is, transmission is a perfect refraction (thin
+// surfaces: a straight pass-through). A delta lobe's sample has flags Specular, f = its weight /
+// |cos| and pdf = the lobe's selection probability p_k; f() and pdf() leave it out (0 for any
+// given pair of directions), and flags() reports it as Specular next to whatever other lobes the
+// material has. Such a mixed BSDF (say metallic 0.5, roughness 0: a mirror plus a diffuse lobe) is
+// not specular-only, so integrators still connect to it through f() and pdf() of the other lobes,
+// and tell a delta sample from the others by its own flags (BsdfSample::is_specular()).
+// The clearcoat is never a delta: GTR1's alpha is at least 0.001 by its definition
+// (lerp(0.1, 0.001, clearcoatgloss)), a glossy lobe at any gloss.
+//
 // Shared by the "disney" and "coateddiffuse" plugins (both compile this file in).
 #pragma once
 
@@ -30,10 +43,6 @@ struct DisneyParams {
   float flatness = 0.f;
   float diff_trans = 1.f;      // thin only: 0 reflects all diffuse light, 2 transmits all
 };
-
-/// Smallest microfacet alpha (Burley's clamp): keeps D finite, so roughness 0 is a very sharp
-/// glossy lobe rather than a delta.
-inline constexpr float kMinAlpha = 1e-3f;
 
 class DisneyBsdf final : public Bsdf {
  public:
@@ -64,7 +73,8 @@ class DisneyBsdf final : public Bsdf {
   Weights weights(const Side& side) const;
   Rgb f_upper(const Side& side, const Vec3& wi, TransportMode mode) const;
   float pdf_upper(const Side& side, const Weights& w, const Vec3& wi) const;
-  bool rough_transmission() const { return transmissive_ && !pass_through_; }
+  bool rough_transmission() const { return transmissive_ && !transmission_delta_; }
+  bool rough_specular() const { return specular_.active(eta_) && !specular_delta_; }
 
   DiffuseLobes diffuse_;
   SpecularReflection specular_;
@@ -72,8 +82,11 @@ class DisneyBsdf final : public Bsdf {
   RoughTransmission transmission_;
   Rgb diffuse_transmission_{0.f};  // thin surfaces: Lambertian transmission
   float eta_;
+  bool thin_;
   bool transmissive_;              // has a specular transmission lobe
   bool pass_through_;              // eta ~ 1: that lobe is a straight delta pass-through
+  bool specular_delta_;            // the specular reflection is a mirror (alpha < kSmoothAlpha)
+  bool transmission_delta_;        // transmission is a delta: pass-through or alpha < kSmoothAlpha
   uint32_t flags_ = 0;
 };
 

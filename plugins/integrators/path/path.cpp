@@ -72,7 +72,9 @@ class PathIntegrator final : public PixelIntegrator {
       Vec3 wo = si->shading.to_local(si->wo);
       ShadingContext sctx{si->uv, TransportMode::Radiance};
 
-      // Next-event estimation (the dimensions are drawn even when unused).
+      // Next-event estimation (the dimensions are drawn even when unused). A BSDF with delta lobes
+      // among others (Disney's mirror on a diffuse base) gets it through f() and pdf() of the others;
+      // its delta samples are told apart below by their own flag (no MIS for what they hit).
       float u_light = sampler.get_1d();
       Vec2 u_light_point = sampler.get_2d();
       if (light_sampling_ && bsdf.flags() != 0 && !bsdf.is_specular_only())

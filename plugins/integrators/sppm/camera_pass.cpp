@@ -74,6 +74,23 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
   return L;
 }
 
+// The number of fresh BSDF samples up to and including the first that is not a delta: geometric with
+// mean 1 / P(not a delta), an unbiased estimate of it (on average one draw per call, however small P
+// is, since the caller reaches here with probability P). The cap only guards against a BSDF whose
+// flags promise non-delta lobes it never samples. The dimensions follow the path's last ones: the
+// path ends here.
+int draws_until_not_specular(const Bsdf& bsdf, const Vec3& wo, const ShadingContext& sctx, Sampler& sampler) {
+  constexpr int kMaxDraws = 1 << 16;
+  int n = 1;
+  for (; n < kMaxDraws; ++n) {
+    float uc = sampler.get_1d();
+    Vec2 u = sampler.get_2d();
+    std::optional<BsdfSample> s = bsdf.sample_f(wo, uc, u, sctx);
+    if (!s || !s->is_specular()) break;
+  }
+  return n;
+}
+
 }  // namespace
 
 CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth) {
@@ -109,19 +126,31 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     ShadingContext sctx{si->uv, TransportMode::Radiance};
     if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du);
 
+    // The continuation; a BSDF with diffuse and delta lobes needs it for the decision below.
+    const bool diffuse = flags & BsdfDiffuse, has_delta = flags & BsdfSpecular;
+    std::optional<BsdfSample> bs;
+    if (!diffuse || has_delta) bs = bsdf.sample_f(wo, u_lobe, u_dir, sctx);
+
     // A diffuse surface keeps the point for the photons, unless no photon path could still fit
-    // within maxdepth (then direct light was all there was to add).
-    if (flags & BsdfDiffuse) {
+    // within maxdepth (then direct light was all there was to add). A delta lobe next to the
+    // diffuse one (a Disney mirror on a diffuse base) is invisible to the point (the gather uses
+    // f(), which leaves deltas out), so its light must come from the camera side: the BSDF's own
+    // lobe choice splits the two. A delta sample continues the path (its weight F / p_delta is
+    // unbiased for the delta part); any other outcome leaves the point, weighted by an unbiased
+    // estimate of 1 / P(not a delta).
+    if (diffuse && !(has_delta && bs && bs->is_specular())) {
       if (depth + 1 < max_depth) {
-        out.vp = VisiblePoint{si->shading, wo, si->uv, &bsdf, beta, max_depth - 1 - depth};
+        Rgb vp_beta = beta;
+        if (has_delta) vp_beta *= float(draws_until_not_specular(bsdf, wo, sctx, sampler));
+        out.vp = VisiblePoint{si->shading, wo, si->uv, &bsdf, vp_beta, max_depth - 1 - depth};
         out.p = si->p;
         out.distance = distance;
       }
       break;
     }
 
-    // Specular and glossy surfaces pass the path on: photons are poor at narrow lobes.
-    std::optional<BsdfSample> bs = bsdf.sample_f(wo, u_lobe, u_dir, sctx);
+    // Specular and glossy surfaces (and a mixed BSDF's delta samples) pass the path on: photons are
+    // poor at narrow lobes.
     if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
     Vec3 wi = si->shading.to_world(bs->wi);
     if (!consistent_sides(*si, wo, bs->wi, wi)) break;

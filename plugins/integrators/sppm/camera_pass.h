@@ -20,7 +20,8 @@ struct CameraPathResult {
 /// Traces the camera path that starts with `camera_ray`; the render loop has started `sampler` at
 /// the pixel sample and drawn the pixel (2) and lens (2) dimensions. Then 10 dimensions per bounce
 /// (light 1 + 2, direct-light BSDF sample 1 + 2, continuation 1 + 2, roulette 1), drawn whether used
-/// or not so that quasi-random samplers keep their dimensions aligned across paths.
+/// or not so that quasi-random samplers keep their dimensions aligned across paths. A visible point
+/// on a BSDF with delta and diffuse lobes draws 3 more per extra BSDF sample after the last bounce's.
 CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth);
 
 }  // namespace penumbra::sppm
