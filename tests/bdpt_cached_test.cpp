@@ -360,10 +360,7 @@ TEST(BdptCached, StatsReportConnectionsAndBvhFigures) {
 // Every bundled scene, rendered with both cached techniques on (and with HRR alone at glossy eye
 // vertices only): no NaN, no Inf, no discarded sample.
 TEST(BdptCached, NoNonFiniteValuesOnBundledScenes) {
-  std::vector<std::string> files;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(std::string(PENUMBRA_SOURCE_DIR) + "/scenes"))
-    if (entry.path().extension() == ".pbrt" && entry.path().filename() != "unit-cube.pbrt") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
+  std::vector<std::string> files = test::bundled_scene_files();
   ASSERT_GE(files.size(), 6u);
   const std::vector<std::vector<ParamOverride>> settings = {
       {{"hrr", "true", "test"}, {"hrrmaxalpha", "1", "test"}, {"probconnect", "true", "test"}, {"hrrconnections", "8", "test"}},

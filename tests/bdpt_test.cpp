@@ -609,24 +609,9 @@ TEST(Bdpt, StrategyImagesSumToTheImage) {
     ASSERT_NEAR(sum[i], r.image.pixels[i], 1e-4 * (1.0 + r.image.pixels[i])) << "value " << i;
 }
 
-// A scene file, as opposed to a piece other scenes Include (unit-cube.pbrt, scenes/bench/*-geometry.pbrt):
-// only whole scenes have a WorldBegin directive (at the start of a line, not in a comment).
-static bool is_whole_scene(const std::string& file) {
-  std::ifstream in(file);
-  std::string line;
-  while (std::getline(in, line)) {
-    size_t start = line.find_first_not_of(" \t");
-    if (start != std::string::npos && line.compare(start, 10, "WorldBegin") == 0) return true;
-  }
-  return false;
-}
-
 // No NaN or Inf on any bundled scene (tiny renders: 24x24, 2 spp; pbrt-v4's scenes too).
 TEST(Bdpt, NoNonFiniteValuesOnBundledScenes) {
-  std::vector<std::string> files;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(std::string(PENUMBRA_SOURCE_DIR) + "/scenes"))
-    if (entry.path().extension() == ".pbrt" && is_whole_scene(entry.path().string())) files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
+  std::vector<std::string> files = test::bundled_scene_files();
   ASSERT_GE(files.size(), 6u);
   for (const std::string& file : files)
     for (const char* integrator : {"bdpt", "lighttracing"}) {

@@ -8,6 +8,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <vector>
+
 using namespace penumbra;
 
 namespace {
@@ -65,4 +70,20 @@ TEST(RayOffset, NoSelfIntersectionOnSphereFromOutsideOrInside) {
     if (!outward && (!next || next->t < 1e-3f)) ++bad;  // going inside: must reach the far side
   }
   EXPECT_EQ(bad, 0);
+}
+
+// The bit-level next_float_up/down agree with std::nextafter on every class of finite float.
+TEST(RayOffset, NextFloatMatchesNextafter) {
+  std::vector<float> values = {0.f, -0.f, 1.f, -1.f, 1e-40f, -1e-40f, 1e38f, -1e38f, 3.4028235e38f, -3.4028235e38f,
+                               std::numeric_limits<float>::denorm_min(), -std::numeric_limits<float>::denorm_min()};
+  uint32_t state = 7;
+  for (int i = 0; i < 100000; ++i) {
+    state = state * 1664525u + 1013904223u;
+    float v = std::bit_cast<float>(state);
+    if (std::isfinite(v)) values.push_back(v);
+  }
+  for (float v : values) {
+    EXPECT_EQ(std::bit_cast<uint32_t>(next_float_up(v)), std::bit_cast<uint32_t>(std::nextafter(v, Infinity))) << v;
+    EXPECT_EQ(std::bit_cast<uint32_t>(next_float_down(v)), std::bit_cast<uint32_t>(std::nextafter(v, -Infinity))) << v;
+  }
 }

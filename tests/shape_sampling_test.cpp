@@ -129,3 +129,14 @@ TEST(TriangleSampling, SmallDistantTriangleFallsBackToAreaSamplingChiSquare) {
   EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
   EXPECT_NEAR(r.pdf_integral, 1.0, 5e-3);
 }
+
+// Subtends about 0.05 sr (area over squared centroid distance 0.05, below the 0.25 where spherical
+// sampling pays): sampled by area, and the pdf makes the same choice.
+TEST(TriangleSampling, ModerateTriangleUsesAreaSamplingChiSquare) {
+  TriangleMesh mesh;
+  mesh.P = {Vec3(-0.5f, -0.4f, 3), Vec3(0.6f, -0.3f, 3.2f), Vec3(0.1f, 0.7f, 2.9f)};
+  mesh.indices = {0, 1, 2};
+  ChiSquareResult r = triangle_chi_square(mesh, std::cos(0.3));
+  EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
+  EXPECT_NEAR(r.pdf_integral, 1.0, 3e-3);
+}

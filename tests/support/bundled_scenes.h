@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace penumbra::test {
 
@@ -9,5 +10,10 @@ namespace penumbra::test {
 /// by `integrator_line` (kept when empty) and, if `box_filter`, a box pixel filter instead of the
 /// Gaussian (splats then land in one pixel, as pixel samples do). Returns the scene file's path.
 std::string cornell_box_copy(const std::string& name, const std::string& integrator_line, bool box_filter = false);
+
+/// Every whole scene under scenes/ (files with a WorldBegin directive at the start of a line; pieces
+/// that other scenes Include, such as unit-cube.pbrt or scenes/bench/*-geometry.pbrt, are left out),
+/// sorted.
+std::vector<std::string> bundled_scene_files();
 
 }  // namespace penumbra::test

@@ -4,6 +4,9 @@
 // its own surface nor starts far from it, at any distance from the origin or any scene scale.
 #pragma once
 
+#include <bit>
+#include <cstdint>
+
 #include <penumbra/color.h>
 #include <penumbra/math.h>
 
@@ -31,6 +34,23 @@ constexpr float error_gamma(int n) {
 /// for points near the origin.
 inline Vec3 point_error_bound(const Vec3& p) { return error_gamma(7) * glm::abs(p) + Vec3(1e-7f); }
 
+/// The next float above (below) v, for finite v (pbrt's NextFloatUp/Down; std::nextafter is a libm
+/// call several times slower, and this runs six times per spawned ray).
+inline float next_float_up(float v) {
+  if (std::isinf(v) && v > 0.f) return v;
+  if (v == -0.f) v = 0.f;
+  uint32_t u = std::bit_cast<uint32_t>(v);
+  u = v >= 0.f ? u + 1 : u - 1;
+  return std::bit_cast<float>(u);
+}
+inline float next_float_down(float v) {
+  if (std::isinf(v) && v < 0.f) return v;
+  if (v == 0.f) v = -0.f;
+  uint32_t u = std::bit_cast<uint32_t>(v);
+  u = v > 0.f ? u - 1 : u + 1;
+  return std::bit_cast<float>(u);
+}
+
 /// Moves `p` (absolute error at most p_error per component) off a surface with geometric normal `n`
 /// towards the side `w` points to: past the error box along n, each coordinate rounded away.
 inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, Vec3 n, const Vec3& w) {
@@ -39,8 +59,8 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, Vec3 n, const 
   if (glm::dot(w, n) < 0.f) offset = -offset;
   Vec3 po = p + offset;
   for (int k = 0; k < 3; ++k) {
-    if (offset[k] > 0.f) po[k] = std::nextafter(po[k], Infinity);
-    else if (offset[k] < 0.f) po[k] = std::nextafter(po[k], -Infinity);
+    if (offset[k] > 0.f) po[k] = next_float_up(po[k]);
+    else if (offset[k] < 0.f) po[k] = next_float_down(po[k]);
   }
   return po;
 }

@@ -43,16 +43,20 @@ struct TriangleMesh {
 
 class Triangle final : public Shape {
  public:
-  Triangle(const TriangleMesh* mesh, uint32_t index) : mesh_(mesh), index_(index) {}
-  float area() const override { return mesh_->area(index_); }
+  Triangle(const TriangleMesh* mesh, uint32_t index);
+  float area() const override { return area_; }
   ShapeSample sample_area(Vec2 u) const override;
   std::optional<ShapeSample> sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const override;
   float pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
                         const Vec3& n_hit) const override;
 
  private:
+  bool spherical_worthwhile(const Vec3& p) const;
+  std::optional<ShapeSample> sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const;
   const TriangleMesh* mesh_;
   uint32_t index_;
+  Vec3 centroid_;
+  float area_;
 };
 
 }  // namespace penumbra

@@ -191,7 +191,8 @@ std::optional<BsdfSample> DisneyBsdf::sample_f(const Vec3& wo, float uc, Vec2 u,
         if (!(T > 0.f) || wt.z == 0.f) return std::nullopt;
         Rgb f = transmission_.tint * (T / std::abs(wt.z));
         if (ctx.mode == TransportMode::Radiance && !thin_) f /= sqr(etap);
-        return BsdfSample{f, side.to_upper(wt), w.transmission / sum, BsdfTransmission | BsdfSpecular};
+        return BsdfSample{f, side.to_upper(wt), w.transmission / sum, BsdfTransmission | BsdfSpecular,
+                          thin_ ? 1.f : etap};
       }
       wi = transmission_.sample(side.wo, u, side.eta);
       sampled = BsdfTransmission | BsdfGlossy;
@@ -207,7 +208,9 @@ std::optional<BsdfSample> DisneyBsdf::sample_f(const Vec3& wo, float uc, Vec2 u,
   if (!wi || wi->z == 0.f) return std::nullopt;
   float pdf = pdf_upper(side, w, *wi);
   if (!(pdf > 0.f)) return std::nullopt;
-  return BsdfSample{f_upper(side, *wi, ctx.mode), side.to_upper(*wi), pdf, sampled};
+  // The rough transmission lobe scales radiance by 1/eta^2 (disney_lobes.cpp), which the sample reports.
+  float eta = sampled == (BsdfTransmission | BsdfGlossy) ? side.eta : 1.f;
+  return BsdfSample{f_upper(side, *wi, ctx.mode), side.to_upper(*wi), pdf, sampled, eta};
 }
 
 LobeSummary DisneyBsdf::lobe(const Vec3& wo, const ShadingContext&) const {
