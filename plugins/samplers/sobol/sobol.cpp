@@ -28,6 +28,7 @@
 #include <penumbra/sampler.h>
 
 #include <algorithm>
+#include <bit>
 #include <string>
 
 namespace {
@@ -51,18 +52,32 @@ uint32_t reverse_bits(uint32_t v) {
   return ((v & 0x55555555u) << 1) | ((v & 0xaaaaaaaau) >> 1);
 }
 
-uint32_t sobol_bits(uint32_t index, uint32_t dim) {
+// The generator matrices with every column bit-reversed, made once when the plugin loads: fast Owen
+// scrambling works on the reversed value, so the sample is reversed once instead of twice.
+struct ReversedMatrices {
+  uint32_t columns[kSobolDimensions][32];
+  ReversedMatrices() {
+    for (uint32_t d = 0; d < kSobolDimensions; ++d)
+      for (int c = 0; c < 32; ++c) columns[d][c] = reverse_bits(kSobolMatrices[d][c]);
+  }
+};
+const ReversedMatrices kReversed;
+
+// reverse_bits of the Sobol sample `index` in dimension `dim`: the XOR of the columns of the set
+// bits of the index (visited by their positions, so an index costs its popcount).
+uint32_t sobol_bits_reversed(uint32_t index, uint32_t dim) {
   uint32_t v = 0;
-  for (const uint32_t* column = kSobolMatrices[dim]; index != 0; index >>= 1, ++column)
-    if (index & 1) v ^= *column;
+  const uint32_t* columns = kReversed.columns[dim];
+  for (; index != 0; index &= index - 1) v ^= columns[std::countr_zero(index)];
   return v;
 }
 
 // With the bits reversed, adding a constant, multiplying by an odd number and x ^= x * even all
 // change bit k only as a function of bits below k: after reversing back, every bit of the value is
 // flipped by a function of the bits above it, which is what nested (Owen) scrambling needs.
-uint32_t fast_owen_scramble(uint32_t v, uint32_t seed) {
-  v = reverse_bits(v);
+// Fast Owen scrambling (Burley's hash-based nested scrambling) of a bit-reversed sample `v`; returns
+// the scrambled sample in its natural bit order.
+uint32_t fast_owen_scramble_reversed(uint32_t v, uint32_t seed) {
   v += seed;
   v ^= v * 0x6c50b47cu;
   v ^= v * 0xb82f1e52u;
@@ -106,12 +121,14 @@ class SobolSampler final : public DimensionSampler {
     // SplitMix-style: consecutive dimensions get unrelated scrambling keys.
     uint64_t key = mix_bits(pixel_key_ + (dim + 1ull) * 0x9e3779b97f4a7c15ull);
     if (dim >= kSobolDimensions) return to_unit_float(static_cast<uint32_t>(hash_ints(key, index_) >> 32));
-    uint32_t v = sobol_bits(index_, dim);
+    uint32_t r = sobol_bits_reversed(index_, dim);
+    if (randomization_ == Randomization::FastOwen)
+      return to_unit_float(fast_owen_scramble_reversed(r, static_cast<uint32_t>(key >> 32)));
+    uint32_t v = reverse_bits(r);
     switch (randomization_) {
-      case Randomization::None: break;
       case Randomization::Xor: v ^= static_cast<uint32_t>(key >> 32); break;
-      case Randomization::FastOwen: v = fast_owen_scramble(v, static_cast<uint32_t>(key >> 32)); break;
       case Randomization::Owen: v = owen_scramble(v, key); break;
+      default: break;
     }
     return to_unit_float(v);
   }
