@@ -4,7 +4,7 @@
 # light: through the glass sphere a point light's caustic is a specular path ending on a delta light,
 # which only light tracing (bdpt's t = 1 strategy) renders.
 BENCH_SCENE_TABLE="
-cornell-spheres-area   scenes/bench/cornell-spheres-area.pbrt   path
+cornell-spheres-area   scenes/bench/cornell-spheres-area.pbrt   bdpt
 cornell-spheres-point  scenes/bench/cornell-spheres-point.pbrt  bdpt
 cornell-spheres-env    scenes/bench/cornell-spheres-env.pbrt    path
 cornell-box            scenes/cornell-box/scene.pbrt            path
