@@ -5,12 +5,14 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include <set>
 
 using namespace penumbra;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace {
 
@@ -174,10 +176,30 @@ TEST(Cli, BadCommandLineOptionsNameTheOption) {
   EXPECT_THAT(r.err, HasSubstr("unknown integrator 'nope'; available: bdpt, lighttracing, path, sppm"));
 }
 
+// A diffuse sphere under a point light: nothing emits where the camera looks, so maxdepth 0 renders
+// black and maxdepth 1 does not. --integrator bdpt over the scene's "path" keeps maxdepth (bdpt takes
+// it) and drops what bdpt does not take, saying so.
 TEST(Cli, IntegratorOverrideKeepsParametersTheNewPluginTakes) {
-  auto r = render_text("override", scene_with("Integrator \"path\" \"integer maxdepth\" [ 2 ]\n", ""),
-                       {"--integrator", "path", "--spp", "1"});
-  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const std::string world = "LightSource \"point\" \"point3 from\" [ 0 0 5 ] \"rgb I\" [ 10 10 10 ]\n"
+                            "Material \"diffuse\"\nShape \"sphere\" \"float radius\" [ 1 ]\n";
+  for (int depth : {0, 1}) {
+    std::string dir = test::temp_dir("override-" + std::to_string(depth));
+    std::string scene = test::write_file(
+        dir, "scene.pbrt",
+        scene_with(fmt::format("Integrator \"path\" \"integer maxdepth\" [ {} ] \"string strategy\" \"mis\"\n", depth),
+                   world));
+    auto r = test::run_penumbra({"render", scene, "-o", dir + "/out.exr", "--integrator", "bdpt", "--spp", "4", "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("parameter 'strategy' dropped: integrator 'bdpt' does not take it"));
+    EXPECT_THAT(r.err, Not(HasSubstr("'maxdepth' dropped")));
+    ImageRgb img = read_image(dir + "/out.exr");
+    double sum = 0.0;
+    for (float v : img.pixels) sum += v;
+    if (depth == 0)
+      EXPECT_EQ(sum, 0.0) << "maxdepth 0 was not carried over to bdpt";
+    else
+      EXPECT_GT(sum, 0.1) << "maxdepth 1 renders the lit sphere";
+  }
 }
 
 TEST(Cli, NonFiniteSamplesAreDiscardedCountedAndReported) {

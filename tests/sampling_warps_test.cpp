@@ -267,6 +267,24 @@ TEST(Distribution1D, DiscreteSamplingMatchesPmfChiSquare) {
   expect_fits(test::chi_square_discrete([&d](float u) { return d.sample_discrete(u); }, pmf, kSamples, 22));
 }
 
+// Negative control of the discrete test: the same sampler against a pmf with 1 % of the largest
+// bin's probability (7/17.5) moved to another bin must fail (4000 of 10^6 samples, 8 standard
+// deviations), and so must a pmf that misses a bin the sampler can draw.
+TEST(ChiSquareHarness, RejectsDiscreteSamplesAgainstAShiftedPmf) {
+  Distribution1D d(kSteps);
+  std::vector<double> pmf;
+  for (float v : kSteps) pmf.push_back(v / 17.5);
+  std::vector<double> shifted = pmf;
+  shifted[7] += 0.01 * shifted[4];
+  shifted[4] *= 0.99;
+  auto sample = [&d](float u) { return d.sample_discrete(u); };
+  EXPECT_FALSE(test::chi_square_discrete(sample, shifted, kSamples, 22).passes(kAlpha));
+  std::vector<double> missing = pmf;
+  missing[5] += missing[1];
+  missing[1] = 0.0;
+  EXPECT_FALSE(test::chi_square_discrete(sample, missing, kSamples, 22).passes(kAlpha));
+}
+
 TEST(Distribution1D, RemappedUIsUniformWithinTheChosenBin) {
   // (u_remapped, bin) must have density pmf(bin) * n on the strip of that bin: uniform in x and
   // independent of the bin, so callers can reuse the number.

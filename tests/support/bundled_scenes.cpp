@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 namespace penumbra::test {
 
@@ -14,14 +15,16 @@ std::string cornell_box_copy(const std::string& name, const std::string& integra
   if (box_filter) {
     const std::string gaussian = "PixelFilter \"gaussian\"";
     size_t at = text.find(gaussian);
-    if (at != std::string::npos) text.replace(at, gaussian.size(), "PixelFilter \"box\"");
+    if (at == std::string::npos)
+      throw std::runtime_error("cornell_box_copy: scenes/cornell-box/scene.pbrt has no '" + gaussian + "' to replace");
+    text.replace(at, gaussian.size(), "PixelFilter \"box\"");
   }
   if (!integrator_line.empty()) {
     size_t at = text.find("\nIntegrator ");
-    if (at != std::string::npos) {
-      size_t end = text.find('\n', at + 1);
-      text.replace(at + 1, end - at - 1, integrator_line);
-    }
+    if (at == std::string::npos)
+      throw std::runtime_error("cornell_box_copy: scenes/cornell-box/scene.pbrt has no Integrator line to replace");
+    size_t end = text.find('\n', at + 1);
+    text.replace(at + 1, end - at - 1, integrator_line);
   }
   std::string dir = temp_dir(name);
   write_file(dir, "unit-cube.pbrt", read_file(src + "unit-cube.pbrt"));
