@@ -8,6 +8,7 @@
 #include <penumbra/error.h>
 #include <penumbra/microfacet.h>
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -741,3 +742,25 @@ TEST(DisneyBsdf, LobeSummaryLeavesDeltasOutWhenThereAreOtherLobes) {
   EXPECT_LT(std::max(l.alpha_x, l.alpha_y), TrowbridgeReitz::kSmoothAlpha);
   EXPECT_NEAR(std::sqrt(1.f - sqr(l.peak.z)), std::sqrt(1.f - sqr(wo.z)) / 1.5f, 1e-4f);  // refracted
 }
+
+// A white Disney metal (Schlick F with F0 = 1: F = 1) reflects exactly the single-scattering albedo
+// of its GGX microfacets (alpha = roughness^2), bounded from below as well as above; a BSDF 2 % too
+// dark or too bright would fail (checked on the same estimate).
+TEST(DisneyBsdf, RoughWhiteMetalMatchesIndependentAlbedo) {
+  for (double roughness : {0.3, 0.5, 1.0}) {
+    auto bsdf = test::make_bsdf("disney", fmt::format(R"("rgb color" [1 1 1] "float metallic" [1] "float roughness" [{}])",
+                                                      roughness));
+    for (double cos_o : {0.9, 0.5, 0.2}) {
+      Vec3 wo(static_cast<float>(std::sqrt(1.0 - cos_o * cos_o)), 0.f, static_cast<float>(cos_o));
+      double expected = test::ggx_albedo_by_quadrature(roughness * roughness, cos_o);
+      test::AlbedoEstimate a = test::albedo_estimate(*bsdf, wo, 200'000, 6);
+      double tol = 4.0 * a.standard_error.g + 1e-4;
+      std::printf("disney metal roughness %.1f cos %.1f: albedo %.5f +- %.5f, quadrature %.5f\n", roughness, cos_o,
+                  a.mean.g, a.standard_error.g, expected);
+      EXPECT_NEAR(a.mean.g, expected, tol) << "roughness " << roughness << " cos " << cos_o;
+      EXPECT_GT(std::abs(0.98 * a.mean.g - expected), tol) << "a 2 % bias would pass";
+      EXPECT_GT(std::abs(1.02 * a.mean.g - expected), tol) << "a 2 % bias would pass";
+    }
+  }
+}
+
