@@ -31,13 +31,15 @@ Shape "sphere" "float radius" [ 1 ]
 )", sampler, maxdepth, albedo, albedo, albedo, Le, Le, Le);
 }
 
-RenderResult render_text(const std::string& name, const std::string& text, int threads = 0, int seed = -1) {
+RenderResult render_text(const std::string& name, const std::string& text, int threads = 0, int seed = -1,
+                         int spp = 0) {
   std::string dir = test::temp_dir(name);
   RenderSettings s;
   s.scene_file = test::write_file(dir, "scene.pbrt", text);
   s.quiet = true;
   s.threads = threads;
   if (seed >= 0) s.seed = static_cast<uint32_t>(seed);
+  if (spp > 0) s.spp = spp;
   return render(s);
 }
 
@@ -61,13 +63,23 @@ TEST(PathIntegrator, FurnaceWithHighAlbedoStaysUnbiased) {
 }
 
 // Depth convention: maxdepth D collects exactly D bounces, so the image is sum_{k=0..D} a^k * Le.
+// 512 spp. The tolerance is 4 standard errors of the image mean, measured from the pixels' spread; the test
+// asserts that it separates D from D - 1 and D + 1 (a^(D+1) = 1.6 % of the image at D = 5), so an
+// integrator that adds or drops a bounce fails.
 TEST(PathIntegrator, MaxDepthTruncatesSeriesExactly) {
   const float a = 0.5f;
+  auto series = [a](int depth) {
+    double sum = 0.0;
+    for (int k = 0; k <= depth; ++k) sum += std::pow(a, k);
+    return sum;
+  };
   for (int depth : {0, 1, 2, 5}) {
-    double expected = 0.0;
-    for (int k = 0; k <= depth; ++k) expected += std::pow(a, k);
-    RenderResult r = render_text(fmt::format("series{}", depth), furnace_scene(a, 1.f, depth));
-    EXPECT_NEAR(test::mean_channel(r.image, 1), expected, 0.01 * expected) << "maxdepth " << depth;
+    RenderResult r = render_text(fmt::format("series{}", depth), furnace_scene(a, 1.f, depth), 0, -1, 512);
+    double mean = test::mean_channel(r.image, 1), tol = 4.0 * test::standard_error_of_mean(r.image, 1) + 1e-6;
+    EXPECT_NEAR(mean, series(depth), tol) << "maxdepth " << depth;
+    EXPECT_GT(std::abs(mean - series(depth + 1)), tol) << "maxdepth " << depth << " is not told from " << depth + 1;
+    if (depth > 0)
+      EXPECT_GT(std::abs(mean - series(depth - 1)), tol) << "maxdepth " << depth << " is not told from " << depth - 1;
   }
 }
 

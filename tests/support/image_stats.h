@@ -17,6 +17,15 @@ inline double mean_luminance_free(const ImageRgb& img) {
   return (mean_channel(img, 0) + mean_channel(img, 1) + mean_channel(img, 2)) / 3.0;
 }
 
+/// Standard error of mean_channel(img, c) from the spread of the pixels (independent pixels: each
+/// is its own mean of independent samples, so the pixels' variance over their count measures it).
+inline double standard_error_of_mean(const ImageRgb& img, int c) {
+  double mean = mean_channel(img, c), sum2 = 0.0;
+  size_t n = img.pixels.size() / 3;
+  for (size_t i = 0; i < n; ++i) sum2 += (img.pixels[3 * i + c] - mean) * (img.pixels[3 * i + c] - mean);
+  return std::sqrt(sum2 / (n - 1) / n);
+}
+
 inline int count_nonfinite(const ImageRgb& img) {
   int n = 0;
   for (float v : img.pixels) n += std::isfinite(v) ? 0 : 1;
