@@ -305,21 +305,63 @@ double worst_block(const ImageRgb& a, const ImageRgb& b, int y0, double floor) {
 
 }  // namespace
 
+namespace {
+
+// Mean and standard error of the per-pixel difference a - b (channels averaged) over rows y0.. of
+// the pixels of block (bx, by) of 8x8 (bx < 0: the whole region).
+struct Difference {
+  double mean = 0.0, standard_error = 0.0;
+};
+Difference difference(const ImageRgb& a, const ImageRgb& b, int y0, int bx = -1, int by = -1) {
+  double sum = 0.0, sum2 = 0.0;
+  int n = 0;
+  for (int y = std::max(y0, by < 0 ? 0 : by * 8); y < (by < 0 ? a.height : (by + 1) * 8); ++y)
+    for (int x = bx < 0 ? 0 : bx * 8; x < (bx < 0 ? a.width : (bx + 1) * 8); ++x) {
+      double d = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        size_t i = 3 * (static_cast<size_t>(y) * a.width + x) + c;
+        d += (a.pixels[i] - b.pixels[i]) / 3.0;
+      }
+      sum += d;
+      sum2 += d * d;
+      ++n;
+    }
+  Difference r;
+  if (n < 2) return r;
+  r.mean = sum / n;
+  r.standard_error = std::sqrt(std::max(0.0, (sum2 - n * r.mean * r.mean) / (n - 1)) / n);
+  return r;
+}
+
+}  // namespace
+
 // Cornell box, 32x32, rows 6-31 (below the light): path at 1024 spp against bdpt with the cached
-// techniques at 48 spp. Measured at 128 spp: means +0.27 to +0.34 % (plain bdpt: +0.22 %), worst
-// block 0.8-1.2 %. Tolerances: mean 1 %, worst 4x4 block 5 %.
+// techniques at 96 spp (288 without next-event estimation, whose noise is 1.7x higher: at 48 spp 4
+// standard errors were 1.1 % and 1.9 % of the mean, too wide to see a 1 % bias). The tolerances come from the noise of the renders compared, measured at the
+// spp rendered: the standard error of the mean per-pixel difference (pixels are independent but for
+// light tracing's splats). The region mean and every 4x4 block must agree within 4 standard errors,
+// and the region's 4 standard errors must be below 1 % of its mean, so a 1 % bias would fail.
 TEST(BdptCached, CornellBoxAgreesWithPathForEveryCombination) {
   RenderResult path = render_file(cornell_box("path", "Integrator \"path\" \"integer maxdepth\" [ 8 ]"), 1024, 1);
   double reference = region_mean(path.image, 6);
   for (const auto& [name, params] : combinations()) {
     std::string line = "Integrator \"bdpt\" \"integer maxdepth\" [ 8 ] \"integer hrrconnections\" [ 8 ] " + params;
-    RenderResult r = render_file(cornell_box(name, line), 48, 2);
+    int spp = name.find("no-nextevent") != std::string::npos ? 288 : 96;
+    RenderResult r = render_file(cornell_box(name, line), spp, 2);
     EXPECT_EQ(r.stats.nonfinite_samples, 0u) << name;
-    double m = region_mean(r.image, 6), block = worst_block(r.image, path.image, 6, 0.05);
-    std::printf("cornell %-32s mean %.5f vs path %.5f (%+.2f %%), worst block %.2f %%, %.2f s\n", name.c_str(), m,
-                reference, 100 * (m / reference - 1), 100 * block, r.stats.seconds);
-    EXPECT_LT(std::abs(m / reference - 1), 0.01) << name;
-    EXPECT_LT(block, 0.05) << name;
+    Difference whole = difference(r.image, path.image, 6);
+    double worst_z = 0.0;
+    for (int by = 0; by < 4; ++by)
+      for (int bx = 0; bx < 4; ++bx) {
+        Difference d = difference(r.image, path.image, 6, bx, by);
+        if (d.standard_error > 0.0) worst_z = std::max(worst_z, std::abs(d.mean) / d.standard_error);
+      }
+    std::printf("cornell %-32s mean %+.3f %% of path's (4 standard errors %.3f %%), worst block %.2f standard errors, %.2f s\n",
+                name.c_str(), 100 * whole.mean / reference, 400 * whole.standard_error / reference, worst_z,
+                r.stats.seconds);
+    EXPECT_LT(std::abs(whole.mean), 4.0 * whole.standard_error) << name;
+    EXPECT_LT(4.0 * whole.standard_error, 0.01 * reference) << name << ": a 1 % bias would pass";
+    EXPECT_LT(worst_z, 4.0) << name;
   }
 }
 
@@ -346,7 +388,12 @@ TEST(BdptCached, StatsReportConnectionsAndBvhFigures) {
   // Calibrated to 8 connections per eye vertex on the pilot: the render's mean is of that order.
   EXPECT_GT(stats["hrr_connections_per_eye_vertex"], 4.0);
   EXPECT_LT(stats["hrr_connections_per_eye_vertex"], 16.0);
-  EXPECT_NEAR(stats["pc_connections_per_eye_vertex"], 4.0, 4.0);
+  // probconnections (4) draws at every eye vertex that has a cache point, none elsewhere: at most 4,
+  // and on the closed box the pilot's cache points cover the visible surfaces, so at least 90 % of
+  // the eye vertices find one.
+  std::printf("pc connections per eye vertex %.4f\n", stats["pc_connections_per_eye_vertex"]);
+  EXPECT_LE(stats["pc_connections_per_eye_vertex"], 4.0);
+  EXPECT_GE(stats["pc_connections_per_eye_vertex"], 0.9 * 4.0);
   auto has = [&](const char* s) {
     return std::find(r.stats.structures_built.begin(), r.stats.structures_built.end(), s) != r.stats.structures_built.end();
   };
