@@ -1,4 +1,4 @@
-// Hierarchical Russian roulette (libs/bidirectional/hrr.*; ALGORITHMS.md section 1):
+// Hierarchical Russian roulette (libs/bidirectional/hrr.*; docs/algorithms.md and docs/hrr.md):
 //  1. every leaf's number is marginally U[0,1] (KS per leaf), and the seed's buggy pseudo-code fails;
 //  2. culling is conservative: culled and unculled traversals accept exactly the same pairs;
 //  3. the mean accepted count is sum_i P(y_i, z);

@@ -1,4 +1,4 @@
-// Probabilistic-connection cache (ALGORITHMS.md §2): the slot PMFs are normalised and defensive,
+// Probabilistic-connection cache (docs/algorithms.md, docs/hrr.md): the slot PMFs are normalised and defensive,
 // sample() draws slots with the probabilities it reports, the estimator g(y) V / (R n_c P_r) is
 // unbiased for the sum over all vertices, the frozen MIS approximation sums to about one and ignores
 // later builds, the grid lookup equals brute force, and the records do not depend on the thread count.

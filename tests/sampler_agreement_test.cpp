@@ -20,7 +20,7 @@ ImageRgb render_cornell(const std::string& sampler, int spp, uint32_t seed) {
   return render(s).image;
 }
 
-// relMSE = mean (I - R)^2 / (R^2 + 0.01) (ALGORITHMS.md section 9): the light's few pixels, 20x
+// relMSE = mean (I - R)^2 / (R^2 + 0.01) (docs/algorithms.md, "Image error metrics"): the light's few pixels, 20x
 // brighter than the rest, do not dominate it.
 double rel_mse(const ImageRgb& img, const ImageRgb& ref) {
   double sum = 0;

@@ -2,7 +2,7 @@
 // promise: the Sobol points are Joe & Kuo's and form (t,m,2)-nets before and after scrambling, the
 // Halton pixel mapping hands each pixel the Halton points that fall inside it, every value is in
 // [0, 1), samples are pure functions of (pixel, index, dimension, seed), and both converge faster
-// than the independent sampler on smooth integrands (ALGORITHMS.md §6).
+// than the independent sampler on smooth integrands (docs/algorithms.md, "Low-discrepancy samplers").
 #include "registry/registry.h"
 #include "support/chi_square.h"
 

@@ -28,7 +28,7 @@ using namespace penumbra::sppm;
 
 namespace {
 
-// relMSE = mean (I - R)^2 / (R^2 + 0.01) over pixels and channels (ALGORITHMS.md section 9).
+// relMSE = mean (I - R)^2 / (R^2 + 0.01) over pixels and channels (docs/algorithms.md, "Image error metrics").
 double rel_mse(const ImageRgb& img, const ImageRgb& ref) {
   double sum = 0;
   for (size_t i = 0; i < img.pixels.size(); ++i) {

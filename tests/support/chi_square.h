@@ -1,5 +1,5 @@
 // Chi-square goodness-of-fit tests for samplers: does a sampling routine draw from the density its pdf
-// function reports? Reused for warps, BSDFs, lights and environment maps (ALGORITHMS.md §8.4).
+// function reports? Reused for warps, BSDFs, lights and environment maps (docs/algorithms.md, "Chi-square tests of sampling routines").
 //
 // Recipe (pbrt-v4 / Mitsuba 3): histogram N samples over cells of the domain, integrate the pdf over
 // each cell to get expected counts, pool cells expecting fewer than 5 samples, and compare with

@@ -1,5 +1,5 @@
 // Error metrics between an estimate I and a reference R, averaged over pixels and channels
-// (ALGORITHMS.md section 9). relMSE uses (I - R)^2 / (R^2 + eps) with eps = 0.01.
+// (docs/algorithms.md, "Image error metrics"). relMSE uses (I - R)^2 / (R^2 + eps) with eps = 0.01.
 #pragma once
 
 #include <penumbra/image.h>
