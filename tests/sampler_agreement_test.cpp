@@ -50,28 +50,43 @@ double mean_below_light(const ImageRgb& img) {
 }  // namespace
 
 // Reference: 32x32 pixels at 1024 spp (independent sampler, its own seed). Each sampler renders 16 spp
-// with 3 seeds. Measured (averaged over the seeds): RMSE independent 0.146, halton 0.090, sobol 0.061;
-// relMSE 0.0309, 0.0271, 0.0262. The low-discrepancy samplers gain most where the first dimensions
-// decide (pixel filter and light edges); dark indirectly lit pixels depend on deep dimensions and gain
-// less. Asserted: the mean below the light within 2 % of the reference's for every render; RMSE at least
-// 1.4x (halton) and 1.8x (sobol) lower than independent's; relMSE lower for both.
+// with 6 seeds. The low-discrepancy samplers gain most where the first dimensions decide (pixel filter
+// and light edges); dark indirectly lit pixels depend on deep dimensions and gain less. Asserted, with
+// tolerances from the seed-to-seed spread: every sampler's mean below the light agrees with the
+// reference's, and the RMSE of halton and sobol is lower than independent's by more than the noise of
+// either (measured: 0.146 +- 0.010, 0.089 +- 0.005, 0.067 +- 0.003).
 TEST(SamplerAgreement, LowDiscrepancySamplersAgreeAndHaveLowerErrorOnCornellBox) {
   ImageRgb ref = render_cornell("independent", 1024, 1000);
   double ref_mean = mean_below_light(ref);
-  double err[3] = {0, 0, 0}, rel[3] = {0, 0, 0};
   const char* names[3] = {"independent", "halton", "sobol"};
+  const int seeds = 6;
+  // Per sampler, over the seeds: mean and standard error of the image mean, the RMSE and the relMSE.
+  struct Stat {
+    double sum = 0, sum2 = 0;
+    void add(double v) { sum += v, sum2 += v * v; }
+    double mean() const { return sum / seeds; }
+    double se() const { return std::sqrt(std::max(0.0, (sum2 - seeds * mean() * mean()) / (seeds - 1)) / seeds); }
+  };
+  Stat mean[3], err[3], rel[3];
   for (int k = 0; k < 3; ++k)
-    for (uint32_t seed = 1; seed <= 3; ++seed) {
+    for (uint32_t seed = 1; seed <= seeds; ++seed) {
       ImageRgb img = render_cornell(names[k], 16, seed);
       EXPECT_EQ(test::count_nonfinite(img), 0);
-      EXPECT_NEAR(mean_below_light(img), ref_mean, 0.02 * ref_mean) << names[k] << " seed " << seed;
-      err[k] += rmse(img, ref) / 3.0;
-      rel[k] += rel_mse(img, ref) / 3.0;
+      mean[k].add(mean_below_light(img));
+      err[k].add(rmse(img, ref));
+      rel[k].add(rel_mse(img, ref));
     }
-  std::printf("RMSE at 16 spp vs 1024-spp reference: independent %.4f, halton %.4f, sobol %.4f\n", err[0], err[1], err[2]);
-  std::printf("relMSE: independent %.5f, halton %.5f, sobol %.5f\n", rel[0], rel[1], rel[2]);
-  EXPECT_LT(err[1] * 1.4, err[0]);
-  EXPECT_LT(err[2] * 1.8, err[0]);
-  EXPECT_LT(rel[1], rel[0]);
-  EXPECT_LT(rel[2], rel[0]);
+  for (int k = 0; k < 3; ++k) {
+    std::printf("%-11s mean %.5f +- %.5f (reference %.5f), RMSE %.4f +- %.4f, relMSE %.5f +- %.5f\n", names[k],
+                mean[k].mean(), mean[k].se(), ref_mean, err[k].mean(), err[k].se(), rel[k].mean(), rel[k].se());
+    // Unbiased: within 4 standard errors of the reference, and that tolerance below 2 % of it, so a
+    // sampler 2 % off would fail.
+    EXPECT_NEAR(mean[k].mean(), ref_mean, 4.0 * mean[k].se() + 1e-6) << names[k];
+    EXPECT_LT(4.0 * mean[k].se(), 0.02 * ref_mean) << names[k] << ": a 2 % bias would pass";
+  }
+  // Lower RMSE than independent sampling, by more than 3 standard errors of each side. relMSE is
+  // not asserted: over 6 seeds its spread (0.034 +- 0.006 independent, 0.026 +- 0.003 halton,
+  // 0.029 +- 0.005 sobol) is as large as the differences, because a few bright pixels dominate it.
+  for (int k = 1; k < 3; ++k)
+    EXPECT_LT(err[k].mean() + 3.0 * err[k].se(), err[0].mean() - 3.0 * err[0].se()) << names[k];
 }
