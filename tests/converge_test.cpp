@@ -41,3 +41,44 @@ TEST(Converge, BadConfigurationIsAnError) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.err, HasSubstr("--reference REF.exr or --make-reference SECONDS"));
 }
+
+// With several runs, a study reports medians and quartiles of every metric, and a conclusion about a
+// pair only when the bootstrap interval of their ratio excludes 1: a configuration that truncates
+// paths at one bounce (biased: it misses the indirect light) is told apart; two identical ones are not.
+TEST(Converge, RatiosWithIntervalsConcludeOnlyWhenTheIntervalExcludesOne) {
+  std::string dir = test::temp_dir("converge-ratios");
+  auto r = test::run_penumbra({"converge", std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt",
+                               "--configs", "path:independent,path/maxdepth=1:independent,path/rrdepth=3:independent",
+                               "--make-reference", "2", "--time", "0.4", "--runs", "4", "--snapshots", "2",
+                               "--res", "16x16", "--threads", "2", "-o", dir});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto summary = nlohmann::json::parse(test::read_file(dir + "/summary.json"));
+  EXPECT_EQ(summary["runs"], 4);
+  const auto& last = summary["configs"]["path:independent"]["points"].back();
+  for (const char* m : {"relmse", "rmse", "mae", "relmse_clamped", "relse_median", "worst_share"}) {
+    EXPECT_LE(last[std::string(m) + "_q25"].get<double>(), last[m].get<double>()) << m;
+    EXPECT_LE(last[m].get<double>(), last[std::string(m) + "_q75"].get<double>()) << m;
+  }
+  bool truncated_seen = false, identical_seen = false;
+  for (const auto& ratio : summary["ratios"]) {
+    if (ratio["metric"] != "relmse") continue;
+    EXPECT_LE(ratio["low"].get<double>(), ratio["ratio"].get<double>());
+    EXPECT_LE(ratio["ratio"].get<double>(), ratio["high"].get<double>());
+    if (ratio["a"] == "path:independent" && ratio["b"] == "path/maxdepth=1:independent") {
+      truncated_seen = true;
+      EXPECT_LT(ratio["high"].get<double>(), 1.0);
+      EXPECT_EQ(ratio["conclusion"], "path:independent lower");
+    }
+    if (ratio["a"] == "path:independent" && ratio["b"] == "path/rrdepth=3:independent") {
+      // The same seeds and settings: the runs differ only in the passes each finished in its time.
+      identical_seen = true;
+      EXPECT_LT(ratio["low"].get<double>(), 1.0);
+      EXPECT_GT(ratio["high"].get<double>(), 1.0);
+      EXPECT_EQ(ratio["conclusion"], "no conclusion: the interval contains 1");
+    }
+  }
+  EXPECT_TRUE(truncated_seen);
+  EXPECT_TRUE(identical_seen);
+  EXPECT_THAT(r.err, HasSubstr("worst 0.1 % of pixels hold"));
+  EXPECT_THAT(r.err, HasSubstr("path:independent / path/maxdepth=1:independent relmse at"));
+}

@@ -79,3 +79,24 @@ Shape "sphere"
     }
   EXPECT_NEAR(mse[0] / mse[1], 2.0, 0.2) << "MSE 8 spp " << mse[0] << ", 16 spp " << mse[1];
 }
+
+// The robust metrics on an image whose 2,000 pixels all have error 0.1 except 2 fireflies (0.1 %)
+// of error 100: relMSE is dominated by the fireflies, the clamped relMSE and the median are not, and
+// the worst-0.1 % share says how much of relMSE they hold.
+TEST(ImageMetrics, RobustMetricsSeeThroughFireflies) {
+  ImageRgb ref = constant_image(100, 20, 1.0f), img = constant_image(100, 20, 1.1f);
+  for (int k : {17, 1234})
+    for (int c = 0; c < 3; ++c) img.pixels[3 * k + c] = 101.f;
+  ImageErrors e = image_errors(img, ref);
+  double small = 0.01 / 1.01, big = 1e4 / 1.01;  // per-pixel (I - R)^2 / (R^2 + 0.01)
+  EXPECT_NEAR(e.rel_mse, (1998 * small + 2 * big) / 2000, 1e-4);
+  EXPECT_NEAR(e.rel_se_median, small, 1e-6);
+  // The 99.9th percentile of 2000 sorted values is the 1998th, one of the small ones: both fireflies
+  // are clamped to it.
+  EXPECT_NEAR(e.rel_mse_clamped, small, 1e-6);
+  EXPECT_NEAR(e.worst_share, 2 * big / (1998 * small + 2 * big), 1e-6);
+  // Without fireflies the worst 0.1 % hold 0.1 %.
+  ImageErrors plain = image_errors(constant_image(100, 20, 1.1f), ref);
+  EXPECT_NEAR(plain.worst_share, 0.001, 1e-9);
+  EXPECT_NEAR(plain.rel_mse_clamped, plain.rel_mse, 1e-9);
+}

@@ -13,7 +13,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <map>
+
+#include <penumbra/rng.h>
 
 namespace fs = std::filesystem;
 
@@ -69,6 +72,54 @@ double time_to_reach(const std::vector<std::pair<double, double>>& curve, double
     return std::exp(std::log(t0) + f * (std::log(t1) - std::log(t0)));
   }
   return -1.0;
+}
+
+// Quantile q of `v` (linear interpolation between order statistics); v is copied.
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  double x = q * static_cast<double>(v.size() - 1);
+  size_t i = static_cast<size_t>(std::floor(x));
+  size_t j = std::min(i + 1, v.size() - 1);
+  return v[i] + (x - static_cast<double>(i)) * (v[j] - v[i]);
+}
+
+double median(const std::vector<double>& v) { return quantile(v, 0.5); }
+
+// The metrics a study reports, by name, from one snapshot's errors.
+const std::vector<std::pair<std::string, double ImageErrors::*>>& metrics() {
+  static const std::vector<std::pair<std::string, double ImageErrors::*>> m = {
+      {"relmse", &ImageErrors::rel_mse},
+      {"rmse", &ImageErrors::rmse},
+      {"mae", &ImageErrors::mae},
+      {"relmse_clamped", &ImageErrors::rel_mse_clamped},
+      {"relse_median", &ImageErrors::rel_se_median},
+      {"worst_share", &ImageErrors::worst_share}};
+  return m;
+}
+
+struct RatioInterval {
+  double ratio = 0, low = 0, high = 0;
+};
+
+// Ratio of the medians of a and b with a percentile-bootstrap 95 % interval: runs are resampled with
+// replacement within each configuration (2000 times, fixed seed, so a study's report is reproducible).
+RatioInterval bootstrap_ratio(const std::vector<double>& a, const std::vector<double>& b, uint64_t seed) {
+  RatioInterval r;
+  double mb = median(b);
+  r.ratio = mb != 0.0 ? median(a) / mb : 0.0;
+  Pcg32 rng(seed, 0x626f6f74u /* "boot" */);
+  std::vector<double> ratios, ra(a.size()), rb(b.size());
+  const int resamples = 2000;
+  for (int k = 0; k < resamples; ++k) {
+    for (double& x : ra) x = a[std::min(a.size() - 1, static_cast<size_t>(rng.next_float() * a.size()))];
+    for (double& x : rb) x = b[std::min(b.size() - 1, static_cast<size_t>(rng.next_float() * b.size()))];
+    double d = median(rb);
+    if (d != 0.0) ratios.push_back(median(ra) / d);
+  }
+  r.low = quantile(ratios, 0.025);
+  r.high = quantile(ratios, 0.975);
+  return r;
 }
 
 }  // namespace
@@ -158,37 +209,52 @@ int run_converge(const ConvergeSettings& s) {
 
   // Raw rows.
   std::ofstream csv(fs::path(s.out_dir) / "results.csv");
-  csv << "config,run,snapshot,seconds,spp,rmse,relmse,mae\n";
+  csv << "config,run,snapshot,seconds,spp,rmse,relmse,mae,relmse_clamped,relse_median,worst_share\n";
   for (const Row& row : rows)
-    csv << fmt::format("{},{},{},{:.6g},{},{:.6g},{:.6g},{:.6g}\n", row.config, row.run, row.snapshot, row.seconds,
-                       row.spp, row.errors.rmse, row.errors.rel_mse, row.errors.mae);
+    csv << fmt::format("{},{},{},{:.6g},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", row.config, row.run,
+                       row.snapshot, row.seconds, row.spp, row.errors.rmse, row.errors.rel_mse, row.errors.mae,
+                       row.errors.rel_mse_clamped, row.errors.rel_se_median, row.errors.worst_share);
 
-  // Mean and spread per configuration and snapshot; time to reach a common relMSE; efficiency.
+  // Per configuration and snapshot, over the runs: the median and interquartile range of every metric
+  // (a heavy-tailed estimator's mean error is decided by its worst run); efficiency and the time to
+  // reach a common relMSE from the median curves.
   nlohmann::json summary;
   summary["scene"] = s.scene;
   summary["relmse_epsilon"] = kRelMseEpsilon;
   summary["relmse_formula"] = "mean over pixels and channels of (I - R)^2 / (R^2 + eps), reference variance subtracted";
+  summary["statistics"] = "median and interquartile range over runs; ratios: medians with a bootstrap 95 % interval";
   summary["reference_variance_subtracted"] = have_variance;
   summary["time_budget"] = s.time;
   summary["runs"] = s.runs;
+  auto values = [&](const std::string& config, int snapshot, double ImageErrors::*field) {
+    std::vector<double> v;
+    for (const Row& row : rows)
+      if (row.config == config && row.snapshot == snapshot) v.push_back(row.errors.*field);
+    return v;
+  };
   std::map<std::string, std::vector<std::pair<double, double>>> curves;
+  std::map<std::string, int> last_snapshot;
   double common_target = 0.0;
   for (const auto& config : s.configs) {
-    std::string name = config.name;
+    const std::string& name = config.name;
     nlohmann::json points = nlohmann::json::array();
     for (int k = 0; k < s.snapshots; ++k) {
-      double t = 0, spp = 0, rmse = 0, rel = 0, mae = 0, rel_min = 1e300, rel_max = -1e300;
-      int n = 0;
+      std::vector<double> t, spp;
       for (const Row& row : rows)
-        if (row.config == name && row.snapshot == k) {
-          t += row.seconds, spp += row.spp, rmse += row.errors.rmse, rel += row.errors.rel_mse, mae += row.errors.mae;
-          rel_min = std::min(rel_min, row.errors.rel_mse), rel_max = std::max(rel_max, row.errors.rel_mse);
-          ++n;
-        }
-      if (n == 0) continue;
-      points.push_back({{"seconds", t / n}, {"spp", spp / n}, {"rmse", rmse / n}, {"relmse", rel / n},
-                        {"relmse_min", rel_min}, {"relmse_max", rel_max}, {"mae", mae / n}, {"runs", n}});
-      curves[name].emplace_back(t / n, rel / n);
+        if (row.config == name && row.snapshot == k) t.push_back(row.seconds), spp.push_back(row.spp);
+      if (t.empty()) continue;
+      nlohmann::json p = {{"seconds", median(t)}, {"spp", median(spp)}, {"runs", t.size()}};
+      for (const auto& [metric, field] : metrics()) {
+        std::vector<double> v = values(name, k, field);
+        p[metric] = median(v);
+        p[metric + "_q25"] = quantile(v, 0.25);
+        p[metric + "_q75"] = quantile(v, 0.75);
+        p[metric + "_min"] = quantile(v, 0.0);
+        p[metric + "_max"] = quantile(v, 1.0);
+      }
+      points.push_back(p);
+      curves[name].emplace_back(median(t), p["relmse"].get<double>());
+      last_snapshot[name] = k;
     }
     summary["configs"][name]["points"] = points;
     if (!curves[name].empty()) {
@@ -196,11 +262,42 @@ int run_converge(const ConvergeSettings& s) {
       summary["configs"][name]["final_relmse"] = rel_final;
       summary["configs"][name]["efficiency"] = rel_final > 0 ? 1.0 / (rel_final * t_final) : 0.0;
       common_target = std::max(common_target, rel_final);
+      const nlohmann::json& last = points.back();
+      std::fprintf(stderr,
+                   "converge: %-28s at %5.1f s: relMSE %.4g [%.4g, %.4g], RMSE %.4g [%.4g, %.4g], MAE %.4g, "
+                   "clamped relMSE %.4g, worst 0.1 %% of pixels hold %.0f %% of the squared error\n",
+                   name.c_str(), t_final, last["relmse"].get<double>(), last["relmse_q25"].get<double>(),
+                   last["relmse_q75"].get<double>(), last["rmse"].get<double>(), last["rmse_q25"].get<double>(),
+                   last["rmse_q75"].get<double>(), last["mae"].get<double>(), last["relmse_clamped"].get<double>(),
+                   100.0 * last["worst_share"].get<double>());
     }
   }
-  // The target every configuration reaches: the worst final relMSE.
+  // The target every configuration reaches: the worst final median relMSE.
   summary["time_to_reach"]["relmse"] = common_target;
   for (const auto& [name, curve] : curves) summary["time_to_reach"]["seconds"][name] = time_to_reach(curve, common_target);
+
+  // Every pairwise ratio at equal time (the last snapshot), with its interval; a conclusion only
+  // where the interval excludes 1.
+  nlohmann::json ratios = nlohmann::json::array();
+  uint64_t boot_seed = 1;
+  for (size_t i = 0; i < s.configs.size(); ++i)
+    for (size_t j = i + 1; j < s.configs.size(); ++j) {
+      const std::string &a = s.configs[i].name, &b = s.configs[j].name;
+      if (!last_snapshot.count(a) || !last_snapshot.count(b)) continue;
+      int k = std::min(last_snapshot[a], last_snapshot[b]);
+      for (const auto& [metric, field] : metrics()) {
+        if (metric == "worst_share") continue;
+        RatioInterval r = bootstrap_ratio(values(a, k, field), values(b, k, field), boot_seed++);
+        std::string conclusion = r.high < 1.0   ? a + " lower"
+                                 : r.low > 1.0 ? b + " lower"
+                                               : "no conclusion: the interval contains 1";
+        ratios.push_back({{"a", a}, {"b", b}, {"metric", metric}, {"snapshot", k}, {"seconds", times[k]},
+                          {"ratio", r.ratio}, {"low", r.low}, {"high", r.high}, {"conclusion", conclusion}});
+        std::fprintf(stderr, "converge: %s / %s %s at %.3g s: %.3g [%.3g, %.3g]: %s\n", a.c_str(), b.c_str(),
+                     metric.c_str(), times[k], r.ratio, r.low, r.high, conclusion.c_str());
+      }
+    }
+  summary["ratios"] = ratios;
   std::ofstream(fs::path(s.out_dir) / "summary.json") << summary.dump(2) << "\n";
   std::fprintf(stderr, "converge: wrote %s/results.csv and summary.json (%zu snapshots)\n", s.out_dir.c_str(), rows.size());
   return 0;

@@ -27,7 +27,7 @@ struct ConvergeSettings {
   std::string reference_config = "path:sobol";
   std::vector<ConvergeConfig> configs;
   double time = 60.0;                    // budget per run, seconds
-  int runs = 4;
+  int runs = 8;
   int snapshots = 8;                     // log-spaced: time / 2^(snapshots-1) ... time
   std::string out_dir = "study";
   std::optional<std::pair<int, int>> resolution;

@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
   converge->add_option("--make-reference", conv.make_reference, "render a reference for this many seconds (two halves)")->check(CLI::PositiveNumber);
   converge->add_option("--reference-config", conv.reference_config, "integrator[/NAME=VALUE...][:sampler] for --make-reference");
   converge->add_option("--time", conv.time, "time budget per run, seconds")->check(CLI::PositiveNumber);
-  converge->add_option("--runs", conv.runs, "independent runs per configuration")->check(CLI::Range(1, 1000));
+  converge->add_option("--runs", conv.runs, "independent runs per configuration (medians, quartiles and bootstrap intervals over them)")->check(CLI::Range(1, 1000));
   converge->add_option("--snapshots", conv.snapshots, "log-spaced snapshots per run")->check(CLI::Range(2, 64));
   converge->add_option("-o,--output", conv.out_dir, "output folder");
   converge->add_option("--res", conv_res, "image resolution WIDTHxHEIGHT");

@@ -4,7 +4,9 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace penumbra {
 
@@ -18,14 +20,32 @@ ImageErrors image_errors(const ImageRgb& image, const ImageRgb& reference, const
   if (reference_variance) check_same_size(image, *reference_variance);
   double se = 0, rel = 0, ae = 0;
   size_t n = image.pixels.size();
+  std::vector<double> per_pixel(n / 3, 0.0);
   for (size_t i = 0; i < n; ++i) {
     double r = reference.pixels[i], d = image.pixels[i] - r;
     double d2 = d * d - (reference_variance ? reference_variance->pixels[i] : 0.0);
     se += d2;
     rel += d2 / (r * r + kRelMseEpsilon);
     ae += std::abs(d);
+    per_pixel[i / 3] += d2 / (r * r + kRelMseEpsilon) / 3.0;
   }
   ImageErrors e;
+  if (!per_pixel.empty()) {
+    std::vector<double> sorted = per_pixel;
+    std::sort(sorted.begin(), sorted.end());
+    size_t m = sorted.size();
+    e.rel_se_median = m % 2 ? sorted[m / 2] : 0.5 * (sorted[m / 2 - 1] + sorted[m / 2]);
+    double cap = sorted[std::min(m - 1, static_cast<size_t>(std::ceil(0.999 * m)) - 1)];
+    size_t worst = std::max<size_t>(1, m / 1000);
+    double total = 0, clamped = 0, top = 0;
+    for (size_t k = 0; k < m; ++k) {
+      total += sorted[k];
+      clamped += std::min(sorted[k], cap);
+      if (k >= m - worst) top += sorted[k];
+    }
+    e.rel_mse_clamped = clamped / m;
+    e.worst_share = total > 0 ? std::clamp(top / total, 0.0, 1.0) : 0.0;
+  }
   e.mse = n ? se / n : 0.0;
   e.rmse = std::sqrt(std::max(0.0, e.mse));
   e.rel_mse = n ? rel / n : 0.0;

@@ -10,6 +10,11 @@ inline constexpr double kRelMseEpsilon = 0.01;
 
 struct ImageErrors {
   double mse = 0, rmse = 0, rel_mse = 0, mae = 0;
+  // Outlier-robust companions of rel_mse, over the per-pixel relative squared errors e_p (mean of the
+  // pixel's channels of (I - R)^2 / (R^2 + eps), reference variance subtracted):
+  double rel_mse_clamped = 0;  // mean of e_p after clamping each at the 99.9th percentile of e_p
+  double rel_se_median = 0;    // median of e_p
+  double worst_share = 0;      // share of sum e_p held by the worst 0.1 % of pixels (fireflies)
 };
 
 /// Errors of `image` against `reference` (same size; throws Error otherwise). When `reference_variance`
