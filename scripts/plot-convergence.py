@@ -22,8 +22,9 @@ def main():
         pts = data["points"]
         t = [p["seconds"] for p in pts]
         rel = [p["relmse"] for p in pts]
-        lo = [max(p["relmse_min"], 1e-12) for p in pts]
-        hi = [p["relmse_max"] for p in pts]
+        # The band is the interquartile range over runs (the range in studies made before quartiles).
+        lo = [max(p.get("relmse_q25", p["relmse_min"]), 1e-12) for p in pts]
+        hi = [p.get("relmse_q75", p["relmse_max"]) for p in pts]
         line, = ax.loglog(t, rel, marker="o", markersize=3, label=name)
         ax.fill_between(t, lo, hi, color=line.get_color(), alpha=0.15)
         t_all += t
@@ -31,7 +32,7 @@ def main():
             # Slope -1 guide through this configuration's first point.
             ax.loglog([t[0], t[-1]], [rel[0], rel[0] * t[0] / t[-1]], "k:", linewidth=1, label="slope -1")
     ax.set_xlabel("render time [s]")
-    ax.set_ylabel("relMSE (eps = %g)" % summary["relmse_epsilon"])
+    ax.set_ylabel("median relMSE over runs, IQR band (eps = %g)" % summary["relmse_epsilon"])
     ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
