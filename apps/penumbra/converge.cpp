@@ -9,7 +9,12 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "parser/scene_description.h"
+#include "render/scene_hash.h"
+
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -45,20 +50,69 @@ RenderSettings base_settings(const ConvergeSettings& s, const ConvergeConfig& co
   return r;
 }
 
+// The reference configuration when none is given: an unbiased integrator that is not among the
+// configurations compared (a reference made by one of them shares its systematic errors), or, when
+// both are compared, one half by each.
+std::vector<std::string> default_reference_configs(const std::vector<ConvergeConfig>& configs) {
+  auto compared = [&](const std::string& integrator) {
+    return std::any_of(configs.begin(), configs.end(), [&](const ConvergeConfig& c) { return c.integrator == integrator; });
+  };
+  if (!compared("path")) return {"path:sobol", "path:sobol"};
+  if (!compared("bdpt")) return {"bdpt:sobol", "bdpt:sobol"};
+  return {"path:sobol", "bdpt:sobol"};
+}
+
+// Where references are kept between studies: $PENUMBRA_REFERENCE_CACHE, else
+// $XDG_CACHE_HOME/penumbra/references, else ~/.cache/penumbra/references.
+fs::path reference_cache_dir() {
+  if (const char* d = std::getenv("PENUMBRA_REFERENCE_CACHE"); d && *d) return d;
+  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return fs::path(d) / "penumbra" / "references";
+  if (const char* h = std::getenv("HOME"); h && *h) return fs::path(h) / ".cache" / "penumbra" / "references";
+  return fs::temp_directory_path() / "penumbra-references";
+}
+
 // Two independent half-length renders: their mean is the reference, and their difference estimates
-// the reference's own variance, which is subtracted from every measured squared error.
-void make_reference(const ConvergeSettings& s, ImageRgb* reference, ImageRgb* variance) {
-  ConvergeConfig config = parse_configs(s.reference_config, "--reference-config").at(0);
+// the reference's own variance, which is subtracted from every measured squared error. Cached by the
+// scene's hash and the reference settings, so a rerun of a study does not remake it.
+void make_reference(const ConvergeSettings& s, const std::vector<std::string>& halves_configs, ImageRgb* reference,
+                    ImageRgb* variance, std::string* description) {
+  std::string res = s.resolution ? fmt::format("{}x{}", s.resolution->first, s.resolution->second) : "scene";
+  std::string key = fmt::format("{}-{}-{}-{}-{:g}s", scene_hash(parse_scene_file(s.scene)), res, halves_configs[0],
+                                halves_configs[1], s.make_reference);
+  for (char& c : key)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
+  *description = halves_configs[0] == halves_configs[1] ? halves_configs[0] : halves_configs[0] + " + " + halves_configs[1];
+  fs::path cache = reference_cache_dir() / key;
   ImageRgb halves[2];
-  for (int h = 0; h < 2; ++h) {
-    RenderSettings r = base_settings(s, config, 1000001u + h);
-    r.time_budget = s.make_reference / 2.0;
-    std::fprintf(stderr, "converge: reference half %d (%s, %.0f s)\n", h + 1, s.reference_config.c_str(), r.time_budget);
-    halves[h] = render(r).image;
+  if (fs::exists(cache / "half-1.exr") && fs::exists(cache / "half-2.exr")) {
+    std::fprintf(stderr, "converge: reference from the cache %s\n", cache.string().c_str());
+    for (int h = 0; h < 2; ++h) halves[h] = read_image((cache / fmt::format("half-{}.exr", h + 1)).string());
+  } else {
+    for (int h = 0; h < 2; ++h) {
+      ConvergeConfig config = parse_configs(halves_configs[h], "--reference-config").at(0);
+      RenderSettings r = base_settings(s, config, 1000001u + h);
+      r.time_budget = s.make_reference / 2.0;
+      std::fprintf(stderr, "converge: reference half %d (%s, %.0f s)\n", h + 1, halves_configs[h].c_str(), r.time_budget);
+      halves[h] = render(r).image;
+    }
+    std::error_code ec;
+    fs::create_directories(cache, ec);
+    if (!ec)
+      for (int h = 0; h < 2; ++h) write_image((cache / fmt::format("half-{}.exr", h + 1)).string(), halves[h]);
   }
   *variance = half_reference_variance(halves[0], halves[1], reference);
   write_image((fs::path(s.out_dir) / "reference.exr").string(), *reference);
   write_image((fs::path(s.out_dir) / "reference-variance.exr").string(), *variance);
+}
+
+// The reference's own error in relMSE units: mean over pixels and channels of Var(R) / (R^2 + eps).
+double reference_relmse(const ImageRgb& reference, const ImageRgb& variance) {
+  double sum = 0.0;
+  for (size_t i = 0; i < reference.pixels.size(); ++i) {
+    double r = reference.pixels[i];
+    sum += variance.pixels[i] / (r * r + kRelMseEpsilon);
+  }
+  return reference.pixels.empty() ? 0.0 : sum / reference.pixels.size();
 }
 
 // Time at which a mean error curve first reaches `target`, interpolated in log-log; -1 if never.
@@ -166,16 +220,20 @@ int run_converge(const ConvergeSettings& s) {
   if (s.snapshots < 2) throw Error("--snapshots must be at least 2");
   // Parameter overrides are checked against the integrators' tables before any long render.
   for (const ConvergeConfig& c : s.configs) check_param_overrides(c.integrator, c.params);
-  if (s.make_reference > 0.0) {
-    ConvergeConfig ref = parse_configs(s.reference_config, "--reference-config").at(0);
-    check_param_overrides(ref.integrator, ref.params);
-  }
+  std::vector<std::string> reference_configs =
+      s.reference_config.empty() ? default_reference_configs(s.configs) : std::vector<std::string>{s.reference_config, s.reference_config};
+  if (s.make_reference > 0.0)
+    for (const std::string& rc : reference_configs) {
+      ConvergeConfig ref = parse_configs(rc, "--reference-config").at(0);
+      check_param_overrides(ref.integrator, ref.params);
+    }
   fs::create_directories(s.out_dir);
 
   ImageRgb reference, variance;
   bool have_variance = false;
+  std::string reference_description = s.reference.empty() ? "" : s.reference;
   if (s.make_reference > 0.0) {
-    make_reference(s, &reference, &variance);
+    make_reference(s, reference_configs, &reference, &variance, &reference_description);
     have_variance = true;
   } else if (!s.reference.empty()) {
     reference = read_image(s.reference);
@@ -192,9 +250,11 @@ int run_converge(const ConvergeSettings& s) {
   for (int k = 0; k < s.snapshots; ++k) times.push_back(s.time * std::pow(2.0, -(s.snapshots - 1 - k)));
 
   std::vector<Row> rows;
-  for (const auto& config : s.configs) {
+  for (size_t ci = 0; ci < s.configs.size(); ++ci) {
+    const ConvergeConfig& config = s.configs[ci];
     for (int run = 0; run < s.runs; ++run) {
-      RenderSettings r = base_settings(s, config, static_cast<uint32_t>(run + 1));
+      // Independent seeds for every run of every configuration: the intervals treat them as such.
+      RenderSettings r = base_settings(s, config, static_cast<uint32_t>(1 + run + 1000 * ci));
       r.time_budget = s.time;
       r.snapshot_times = times;
       int snapshot = 0;
@@ -275,6 +335,22 @@ int run_converge(const ConvergeSettings& s) {
   // The target every configuration reaches: the worst final median relMSE.
   summary["time_to_reach"]["relmse"] = common_target;
   for (const auto& [name, curve] : curves) summary["time_to_reach"]["seconds"][name] = time_to_reach(curve, common_target);
+
+  // The reference's own error against the smallest error it is asked to rank: above 10 % of it, the
+  // ranking may be the reference's, and the report says so loudly.
+  summary["reference"]["made_by"] = reference_description;
+  if (have_variance) {
+    double ref_error = reference_relmse(reference, variance), smallest = 1e300;
+    for (const auto& [name, curve] : curves)
+      if (!curve.empty()) smallest = std::min(smallest, curve.back().second);
+    bool trusted = smallest > 0.0 && ref_error <= 0.1 * smallest;
+    summary["reference"]["relmse"] = ref_error;
+    summary["reference"]["smallest_compared_relmse"] = smallest;
+    summary["reference"]["trusted"] = trusted;
+    std::fprintf(stderr, "converge: reference (%s) own relMSE %.3g, %.0f %% of the smallest error compared (%.3g)%s\n",
+                 reference_description.c_str(), ref_error, smallest > 0 ? 100.0 * ref_error / smallest : 0.0, smallest,
+                 trusted ? "" : ": WARNING: above 10 %, the reference's own noise may decide the ranking; make a longer reference");
+  }
 
   // Every pairwise ratio at equal time (the last snapshot), with its interval; a conclusion only
   // where the interval excludes 1.

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
                        "path:sobol,bdpt/maxdepth=8:sobol; NAME=VALUE sets an integrator parameter as --param does")->required();
   converge->add_option("--reference", conv.reference, "reference image (EXR); reference-variance.exr beside it is used if present")->check(CLI::ExistingFile);
   converge->add_option("--make-reference", conv.make_reference, "render a reference for this many seconds (two halves)")->check(CLI::PositiveNumber);
-  converge->add_option("--reference-config", conv.reference_config, "integrator[/NAME=VALUE...][:sampler] for --make-reference");
+  converge->add_option("--reference-config", conv.reference_config, "integrator[/NAME=VALUE...][:sampler] for --make-reference (default: path, or bdpt when path is compared, or one half each)");
   converge->add_option("--time", conv.time, "time budget per run, seconds")->check(CLI::PositiveNumber);
   converge->add_option("--runs", conv.runs, "independent runs per configuration (medians, quartiles and bootstrap intervals over them)")->check(CLI::Range(1, 1000));
   converge->add_option("--snapshots", conv.snapshots, "log-spaced snapshots per run")->check(CLI::Range(2, 64));
