@@ -12,6 +12,7 @@ packages=(
   python3-matplotlib python3-numpy
   git python3   # bench/integrators.sh: commit hash in its history, table and CSV (standard library only)
   clang-14 libclang-rt-14-dev
+  chromium
 )
 
 missing=()

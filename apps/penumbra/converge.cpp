@@ -1,4 +1,5 @@
 #include "converge.h"
+#include "converge_report.h"
 
 #include "image/image_io.h"
 #include "render/image_metrics.h"
@@ -250,6 +251,8 @@ int run_converge(const ConvergeSettings& s) {
   for (int k = 0; k < s.snapshots; ++k) times.push_back(s.time * std::pow(2.0, -(s.snapshots - 1 - k)));
 
   std::vector<Row> rows;
+  ReportImages report_images;
+  report_images.reference = reference;
   for (size_t ci = 0; ci < s.configs.size(); ++ci) {
     const ConvergeConfig& config = s.configs[ci];
     for (int run = 0; run < s.runs; ++run) {
@@ -258,9 +261,11 @@ int run_converge(const ConvergeSettings& s) {
       r.time_budget = s.time;
       r.snapshot_times = times;
       int snapshot = 0;
+      if (run == 0) report_images.configs.emplace_back(config.name, ImageRgb{});
       r.on_snapshot = [&](double seconds, int spp, const ImageRgb& img) {
         ImageErrors e = image_errors(img, reference, have_variance ? &variance : nullptr);
         rows.push_back(Row{config.name, run, snapshot++, seconds, spp, e});
+        if (run == 0) report_images.configs.back().second = img;  // the first run's latest snapshot
       };
       std::fprintf(stderr, "converge: %s run %d/%d (%.0f s)\n", config.name.c_str(), run + 1, s.runs, s.time);
       render(r);
@@ -375,7 +380,8 @@ int run_converge(const ConvergeSettings& s) {
     }
   summary["ratios"] = ratios;
   std::ofstream(fs::path(s.out_dir) / "summary.json") << summary.dump(2) << "\n";
-  std::fprintf(stderr, "converge: wrote %s/results.csv and summary.json (%zu snapshots)\n", s.out_dir.c_str(), rows.size());
+  write_report((fs::path(s.out_dir) / "report.html").string(), summary, report_images);
+  std::fprintf(stderr, "converge: wrote %s/results.csv, summary.json and report.html (%zu snapshots)\n", s.out_dir.c_str(), rows.size());
   return 0;
 }
 
