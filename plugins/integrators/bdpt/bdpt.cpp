@@ -208,10 +208,9 @@ class BdptIntegrator final : public SampleIntegrator {
 
   Rgb sample(const Scene& scene, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
     const int max_depth = config_.max_depth;
-    thread_local std::vector<Vertex> camera_path, own_light_path;
-    camera_path.resize(max_depth + 2);
-    own_light_path.resize(max_depth + 1);
     if (!px.ray) return Rgb(0.f);
+    SubpathStorage<0> camera_path(max_depth + 2);
+    SubpathStorage<1> own_light_path(max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);
     int nc = camera_subpath(*ctx_, *px.ray, ps, camera_path.data());
     // The pixel's light subpath: from the iteration's cache when it holds it (the same path).

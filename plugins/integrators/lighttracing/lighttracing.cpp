@@ -34,8 +34,7 @@ class LightTracingIntegrator final : public SampleIntegrator {
   }
 
   Rgb sample(const Scene&, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
-    thread_local std::vector<Vertex> light_path;
-    light_path.resize(config_.max_depth + 1);
+    SubpathStorage<0> light_path(config_.max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);
     int nl = light_subpath(*ctx_, ps, light_path.data());
     for (int s = 1; s <= nl; ++s) {
