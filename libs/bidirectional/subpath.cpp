@@ -11,7 +11,7 @@ bool is_at_infinity(const Light* light) {
 }
 
 // Area density at `to` of a solid-angle density at `from` (vertices at infinity keep solid angle).
-float convert_density(float pdf_dir, const Vertex& from, const Vertex& to) {
+inline float convert_density(float pdf_dir, const Vertex& from, const Vertex& to) {
   if (to.infinite) return pdf_dir;
   Vec3 d = to.p - from.p;
   float dist2 = glm::dot(d, d);
@@ -152,11 +152,6 @@ bool Vertex::connectible() const {
     case VertexKind::Surface: return bsdf && bsdf->flags() != 0 && !bsdf->is_specular_only();
   }
   return false;
-}
-
-Vec3 direction_to(const Vertex& from, const Vertex& to) {
-  if (to.infinite) return -to.w_light;
-  return glm::normalize(to.p - from.p);
 }
 
 Rgb Vertex::f(const Vertex& next) const {

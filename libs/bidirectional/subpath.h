@@ -82,7 +82,10 @@ struct Vertex {
 };
 
 /// Unit direction from `from` towards `to` (towards the light for vertices at infinity).
-Vec3 direction_to(const Vertex& from, const Vertex& to);
+inline Vec3 direction_to(const Vertex& from, const Vertex& to) {
+  if (to.infinite) return -to.w_light;
+  return glm::normalize(to.p - from.p);
+}
 
 struct Config {
   int max_depth = 5;  // bounces: strategies with s + t - 2 <= max_depth
