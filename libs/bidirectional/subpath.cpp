@@ -284,7 +284,7 @@ int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
   int n = random_walk(ctx, le->ray, ps, beta, TransportMode::Importance, path, ctx.config.max_depth);
   y0.pdf_fwd = pdf_light_origin(ctx, y0, n > 0 ? path[1] : y0);
   // The same for every connection with s >= 2 (x_0 and x_1 are this path's): once per path.
-  y0.nee_ratio = n > 0 ? static_cast<float>(next_event_ratio(y0, path[1])) : 1.f;
+  if (ctx.config.store_nee_ratio) y0.nee_ratio = n > 0 ? static_cast<float>(next_event_ratio(y0, path[1])) : 1.f;
   return n + 1;
 }
 

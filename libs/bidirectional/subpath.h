@@ -91,6 +91,7 @@ struct Config {
   int max_depth = 5;  // bounces: strategies with s + t - 2 <= max_depth
   int rr_depth = 3;   // bounces of a subpath before Russian roulette may end it
   MisHeuristic heuristic = MisHeuristic::Power;
+  bool store_nee_ratio = true;  // light_subpath() fills Vertex::nee_ratio (MIS needs it; light tracing does not)
 };
 
 /// Reads and checks the parameters bdpt and lighttracing share: "maxdepth", "rrdepth" and

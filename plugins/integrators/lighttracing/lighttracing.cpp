@@ -62,6 +62,7 @@ Object* create(const CreateContext& ctx) {
   const ParamSet& p = ctx.params;
   bool uniform_lights = false;
   Config config = read_subpath_config(p, &uniform_lights);
+  config.store_nee_ratio = false;  // unweighted: no MIS
   return new LightTracingIntegrator(config, uniform_lights);
 }
 
