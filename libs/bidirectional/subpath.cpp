@@ -61,6 +61,20 @@ Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMo
   return v;
 }
 
+// pdf_area(&a, cur, b) and pdf_area(&b, cur, a) for a surface vertex `cur` that has a predecessor,
+// given the local directions towards a and b: one pair of directions for both BSDF densities.
+void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vec3& wa, const Vertex& b, const Vec3& wb,
+                      float* to_b, float* to_a) {
+  ShadingContext sc{cur.uv, cur.mode};
+  *to_b = convert_density(cur.bsdf->pdf(wa, wb, sc), cur, b);
+  *to_a = convert_density(cur.bsdf->pdf(wb, wa, sc), cur, a);
+}
+
+void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vertex& b, float* to_b, float* to_a) {
+  surface_pdf_pair(cur, a, cur.shading.to_local(direction_to(cur, a)), b, cur.shading.to_local(direction_to(cur, b)),
+                   to_b, to_a);
+}
+
 // Extends path[0 .. n-1] (n >= 1, path[n-1] the start point) by at most `max_vertices` scattering
 // vertices; returns how many were added. The stored densities are evaluated between the vertices'
 // positions rather than taken from the sampled directions: spawned rays start a few ULPs off the
@@ -91,8 +105,13 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
       break;
     }
     if (!prev.delta) {
-      v.pdf_fwd = pdf_area(ctx, before, prev, v);  // solid angle for a vertex at infinity
-      if (before) before->pdf_rev = pdf_area(ctx, &v, prev, *before);
+      if (before && prev.kind == VertexKind::Surface) {
+        // Both densities at prev from one pair of directions (the same values as pdf_area's).
+        surface_pdf_pair(prev, *before, v, &v.pdf_fwd, &before->pdf_rev);
+      } else {
+        v.pdf_fwd = pdf_area(ctx, before, prev, v);  // solid angle for a vertex at infinity
+        if (before) before->pdf_rev = pdf_area(ctx, &v, prev, *before);
+      }
     }
     ++added;
     if (!si || added >= max_vertices) break;
@@ -344,14 +363,11 @@ double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex*
   Scratch<double, 1> ratio_scratch(k + 1);
   MisVertex* mv = mv_scratch.data;
   std::span<double> ratios(ratio_scratch.data, k + 1);
-  for (int i = 0; i < s; ++i) {
-    const Vertex& v = L(i);
-    mv[i] = MisVertex{v.pdf_fwd, v.pdf_rev, v.delta};
-  }
-  for (int i = s; i <= k; ++i) {
-    const Vertex& v = C(k - i);
-    mv[i] = MisVertex{v.pdf_rev, v.pdf_fwd, v.delta};
-  }
+  const int s_own = light_end ? s - 1 : s, t_own = camera_end ? t - 1 : t;  // vertices from the subpaths
+  for (int i = 0; i < s_own; ++i) mv[i] = MisVertex{light[i].pdf_fwd, light[i].pdf_rev, light[i].delta};
+  if (s_own < s) mv[s - 1] = MisVertex{light_end->pdf_fwd, light_end->pdf_rev, light_end->delta};
+  for (int j = 0; j < t_own; ++j) mv[k - j] = MisVertex{camera[j].pdf_rev, camera[j].pdf_fwd, camera[j].delta};
+  if (t_own < t) mv[s] = MisVertex{camera_end->pdf_rev, camera_end->pdf_fwd, camera_end->delta};
   // The connected vertices scatter through their non-delta parts; their neighbours' densities change.
   if (s > 0) {
     mv[s - 1].delta = false;
@@ -402,20 +418,6 @@ double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex*
     sums[i] = sum;
   }
   return mis_weight_from_ratios(ratios, s, ctx.config.heuristic, sums, own);
-}
-
-// pdf_area(&a, cur, b) and pdf_area(&b, cur, a) for a surface vertex `cur` that has a predecessor,
-// given the local directions towards a and b: one pair of directions for both BSDF densities.
-void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vec3& wa, const Vertex& b, const Vec3& wb,
-                      float* to_b, float* to_a) {
-  ShadingContext sc{cur.uv, cur.mode};
-  *to_b = convert_density(cur.bsdf->pdf(wa, wb, sc), cur, b);
-  *to_a = convert_density(cur.bsdf->pdf(wb, wa, sc), cur, a);
-}
-
-void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vertex& b, float* to_b, float* to_a) {
-  surface_pdf_pair(cur, a, cur.shading.to_local(direction_to(cur, a)), b, cur.shading.to_local(direction_to(cur, b)),
-                   to_b, to_a);
 }
 
 // Vertex::f() towards world direction wi (local wi_local), wi = direction_to(v, next).
