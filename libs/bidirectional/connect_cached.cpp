@@ -283,12 +283,13 @@ void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camer
                                          const std::function<void(const Connection&, int s)>& emit) const {
   const Vertex& z = camera[t - 1];
   if (t < 2 || !is_connectible_surface(z)) return;
-  eye_vertices_.fetch_add(1, std::memory_order_relaxed);
+  Counters& counters = counters_.local();
+  ++counters.eye_vertices;
   if (opt_.hrr && bvh_.vertex_count() > 0) {
     // A copy: the connections' MIS weights reuse the per-thread memo while the traversal runs.
     const std::optional<HrrRange> range = eye_range(z, camera[t - 2]);
     if (range) {
-      hrr_eye_vertices_.fetch_add(1, std::memory_order_relaxed);
+      ++counters.hrr_eye_vertices;
       HrrRandom rng{hash_ints(opt_.seed, pixel_key(pixel), index, static_cast<uint64_t>(t))};
       HrrTraversalStats stats;
       hrr_traverse(
@@ -302,8 +303,8 @@ void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camer
             if (!is_black(c.L)) emit(c, s);
           },
           opt_.hrr_cull, &stats);
-      hrr_accepted_.fetch_add(stats.accepted, std::memory_order_relaxed);
-      hrr_nodes_.fetch_add(stats.nodes_visited, std::memory_order_relaxed);
+      counters.hrr_accepted += stats.accepted;
+      counters.hrr_nodes += stats.nodes_visited;
     }
   }
   if (opt_.probconnect && cache_.vertex_count() > 0) {
@@ -313,7 +314,7 @@ void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camer
     for (int d = 0; d < opt_.pc_connections; ++d) {
       std::optional<ConnectionCache::Pick> pick = pc_.sample(cp, rng.next_u32() * 0x1p-32);
       if (!pick) break;
-      pc_draws_.fetch_add(1, std::memory_order_relaxed);
+      ++counters.pc_draws;
       LightCache::Ref r = cache_.ref(pick->vertex);
       int s = static_cast<int>(r.vertex) + 1;
       if (s + t - 2 > max_depth_) continue;
@@ -325,30 +326,38 @@ void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camer
 }
 
 std::vector<std::pair<std::string, double>> CachedConnector::statistics() const {
-  double eyes = std::max<double>(1.0, static_cast<double>(eye_vertices_.load()));
+  Counters total;
+  for (const Counters& c : counters_) {
+    total.eye_vertices += c.eye_vertices;
+    total.hrr_eye_vertices += c.hrr_eye_vertices;
+    total.hrr_accepted += c.hrr_accepted;
+    total.hrr_nodes += c.hrr_nodes;
+    total.pc_draws += c.pc_draws;
+  }
+  double eyes = std::max<double>(1.0, static_cast<double>(total.eye_vertices));
   double iters = std::max<double>(1.0, static_cast<double>(iterations_));
   std::vector<std::pair<std::string, double>> s = {
       {"light_paths_per_iteration", static_cast<double>(M_)},
       {"light_vertices_per_iteration", cached_vertices_ / iters},
       {"light_cache_trace_seconds_per_iteration", trace_seconds_ / iters},
       {"light_cache_bytes", static_cast<double>(cache_.memory_bytes())},
-      {"cached_eye_vertices", static_cast<double>(eye_vertices_.load())},
+      {"cached_eye_vertices", static_cast<double>(total.eye_vertices)},
       {"pilot_seconds", calibration_seconds_},
   };
   if (opt_.hrr) {
     s.push_back({"hrr_c", C_});
-    s.push_back({"hrr_connections_per_eye_vertex", hrr_accepted_.load() / eyes});
-    s.push_back({"hrr_eye_vertex_fraction", hrr_eye_vertices_.load() / eyes});
+    s.push_back({"hrr_connections_per_eye_vertex", total.hrr_accepted / eyes});
+    s.push_back({"hrr_eye_vertex_fraction", total.hrr_eye_vertices / eyes});
     s.push_back({"hrr_connections_per_hrr_eye_vertex",
-                 hrr_accepted_.load() / std::max<double>(1.0, static_cast<double>(hrr_eye_vertices_.load()))});
-    s.push_back({"hrr_nodes_visited_per_eye_vertex", hrr_nodes_.load() / eyes});
+                 total.hrr_accepted / std::max<double>(1.0, static_cast<double>(total.hrr_eye_vertices))});
+    s.push_back({"hrr_nodes_visited_per_eye_vertex", total.hrr_nodes / eyes});
     s.push_back({"light_vertex_bvh_build_seconds", build_seconds_ / iters});
     s.push_back({"light_vertex_bvh_bytes_per_vertex",
                  bvh_vertices_ ? static_cast<double>(bvh_bytes_) / bvh_vertices_ : 0.0});
   }
   if (opt_.probconnect) {
     s.push_back({"pc_cache_points", static_cast<double>(pc_.point_count())});
-    s.push_back({"pc_connections_per_eye_vertex", pc_draws_.load() / eyes});
+    s.push_back({"pc_connections_per_eye_vertex", total.pc_draws / eyes});
     s.push_back({"pc_bytes", static_cast<double>(pc_.memory_bytes())});
   }
   return s;

@@ -18,6 +18,8 @@
 #include "prob_connect.h"
 #include "subpath.h"
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -98,8 +100,12 @@ class CachedConnector final : public CachedTechniques {
   LightVertexBvh bvh_;
   ConnectionCache pc_;
   float pc_radius_ = 0.f;
-  // statistics
-  mutable std::atomic<uint64_t> eye_vertices_{0}, hrr_eye_vertices_{0}, hrr_accepted_{0}, hrr_nodes_{0}, pc_draws_{0};
+  // Statistics, counted per thread (a shared atomic per eye vertex would bounce one cache line
+  // between all threads) and summed by statistics().
+  struct alignas(64) Counters {
+    uint64_t eye_vertices = 0, hrr_eye_vertices = 0, hrr_accepted = 0, hrr_nodes = 0, pc_draws = 0;
+  };
+  mutable tbb::enumerable_thread_specific<Counters> counters_;
   double build_seconds_ = 0.0, trace_seconds_ = 0.0, calibration_seconds_ = 0.0;
   uint64_t iterations_ = 0, cached_vertices_ = 0;
   size_t bvh_bytes_ = 0, bvh_vertices_ = 0;

@@ -335,7 +335,11 @@ void hrr_traverse(const LightVertexBvh& bvh, const HrrRange& range, const HrrRan
   using Node = LightVertexBvh::Node;
   hrr_walk(
       bvh, rng,
-      [&](const Node& node, double xi_min) { return cull && !range.may_accept(node.lo, node.hi, xi_min); },
+      // Leaves are decided by the exact test alone (the box test of a leaf would only repeat it,
+      // conservatively and at twice the cost: culling never rejects a vertex the exact test accepts).
+      [&](const Node& node, double xi_min) {
+        return cull && !node.is_leaf() && !range.may_accept(node.lo, node.hi, xi_min);
+      },
       [&](uint32_t vertex, const Node& node, double xi) {
         const double P = range.acceptance(node.lo);
         if (xi < P) {

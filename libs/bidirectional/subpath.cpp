@@ -11,7 +11,7 @@ bool is_at_infinity(const Light* light) {
 }
 
 // Area density at `to` of a solid-angle density at `from` (vertices at infinity keep solid angle).
-float convert_density(float pdf_dir, const Vertex& from, const Vertex& to) {
+inline float convert_density(float pdf_dir, const Vertex& from, const Vertex& to) {
   if (to.infinite) return pdf_dir;
   Vec3 d = to.p - from.p;
   float dist2 = glm::dot(d, d);
@@ -61,6 +61,20 @@ Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMo
   return v;
 }
 
+// pdf_area(&a, cur, b) and pdf_area(&b, cur, a) for a surface vertex `cur` that has a predecessor,
+// given the local directions towards a and b: one pair of directions for both BSDF densities.
+void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vec3& wa, const Vertex& b, const Vec3& wb,
+                      float* to_b, float* to_a) {
+  ShadingContext sc{cur.uv, cur.mode};
+  *to_b = convert_density(cur.bsdf->pdf(wa, wb, sc), cur, b);
+  *to_a = convert_density(cur.bsdf->pdf(wb, wa, sc), cur, a);
+}
+
+void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vertex& b, float* to_b, float* to_a) {
+  surface_pdf_pair(cur, a, cur.shading.to_local(direction_to(cur, a)), b, cur.shading.to_local(direction_to(cur, b)),
+                   to_b, to_a);
+}
+
 // Extends path[0 .. n-1] (n >= 1, path[n-1] the start point) by at most `max_vertices` scattering
 // vertices; returns how many were added. The stored densities are evaluated between the vertices'
 // positions rather than taken from the sampled directions: spawned rays start a few ULPs off the
@@ -91,8 +105,13 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
       break;
     }
     if (!prev.delta) {
-      v.pdf_fwd = pdf_area(ctx, before, prev, v);  // solid angle for a vertex at infinity
-      if (before) before->pdf_rev = pdf_area(ctx, &v, prev, *before);
+      if (before && prev.kind == VertexKind::Surface) {
+        // Both densities at prev from one pair of directions (the same values as pdf_area's).
+        surface_pdf_pair(prev, *before, v, &v.pdf_fwd, &before->pdf_rev);
+      } else {
+        v.pdf_fwd = pdf_area(ctx, before, prev, v);  // solid angle for a vertex at infinity
+        if (before) before->pdf_rev = pdf_area(ctx, &v, prev, *before);
+      }
     }
     ++added;
     if (!si || added >= max_vertices) break;
@@ -130,22 +149,6 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
   return added;
 }
 
-// Unweighted contribution of joining light vertex qs and camera vertex pt (s, t >= 2) with a
-// shadow ray: both throughputs, both BSDFs and the geometry term; 0 when occluded.
-Rgb connect_vertices(const Scene& scene, const Vertex& qs, const Vertex& pt) {
-  if (!qs.connectible() || !pt.connectible() || pt.kind != VertexKind::Surface) return Rgb(0.f);
-  Rgb L = qs.beta * qs.f(pt) * pt.f(qs) * pt.beta;
-  if (is_black(L)) return L;
-  Vec3 d = pt.p - qs.p;
-  float dist2 = glm::dot(d, d);
-  if (!(dist2 > 0.f)) return Rgb(0.f);
-  Vec3 w = d / std::sqrt(dist2);
-  L *= std::abs(glm::dot(qs.ns, w)) * std::abs(glm::dot(pt.ns, w)) / dist2;
-  if (is_black(L) || scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng)))
-    return Rgb(0.f);
-  return L;
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -170,11 +173,6 @@ bool Vertex::connectible() const {
     case VertexKind::Surface: return bsdf && bsdf->flags() != 0 && !bsdf->is_specular_only();
   }
   return false;
-}
-
-Vec3 direction_to(const Vertex& from, const Vertex& to) {
-  if (to.infinite) return -to.w_light;
-  return glm::normalize(to.p - from.p);
 }
 
 Rgb Vertex::f(const Vertex& next) const {
@@ -232,8 +230,28 @@ float pdf_area(const Context& ctx, const Vertex* prev, const Vertex& cur, const 
   return convert_density(pdf_dir, cur, next);
 }
 
+namespace {
+
+// next_event_ratio() given the two densities it needs: pdf_li() of x0 seen from x1 (solid angle) and
+// pdf_le()'s positional density of x0.
+double next_event_ratio_from(const Vertex& x0, const Vertex& x1, float pdf_solid_angle, float pdf_pos) {
+  Vec3 d = x0.p - x1.p;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) return 1.0;
+  Vec3 wi = d / std::sqrt(dist2);
+  if (!(pdf_pos > 0.f)) return 1.0;
+  double nee_area = static_cast<double>(pdf_solid_angle) * std::abs(glm::dot(x0.ng, wi)) / dist2;
+  return nee_area / pdf_pos;
+}
+
+bool next_event_ratio_applies(const Vertex& x0, const Vertex& x1) {
+  return x0.light && x0.light->type() == LightType::Area && x1.on_surface();
+}
+
+}  // namespace
+
 double next_event_ratio(const Vertex& x0, const Vertex& x1) {
-  if (!x0.light || x0.light->type() != LightType::Area || !x1.on_surface()) return 1.0;
+  if (!next_event_ratio_applies(x0, x1)) return 1.0;
   Vec3 d = x0.p - x1.p;
   float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.f)) return 1.0;
@@ -246,9 +264,7 @@ double next_event_ratio(const Vertex& x0, const Vertex& x1) {
   float pdf_solid_angle = x0.light->pdf_li(LightSampleContext{x1.p, x1.ng}, wi, hit);
   float pdf_pos, pdf_dir;
   x0.light->pdf_le(Ray{x0.p, -wi}, x0.ng, &pdf_pos, &pdf_dir);
-  if (!(pdf_pos > 0.f)) return 1.0;
-  double nee_area = static_cast<double>(pdf_solid_angle) * std::abs(glm::dot(x0.ng, wi)) / dist2;
-  return nee_area / pdf_pos;
+  return next_event_ratio_from(x0, x1, pdf_solid_angle, pdf_pos);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -288,60 +304,101 @@ int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
   Rgb beta = le->L * cos0 / (sl->pmf * le->pdf_pos * le->pdf_dir);
   int n = random_walk(ctx, le->ray, ps, beta, TransportMode::Importance, path, ctx.config.max_depth);
   y0.pdf_fwd = pdf_light_origin(ctx, y0, n > 0 ? path[1] : y0);
+  // The same for every connection with s >= 2 (x_0 and x_1 are this path's): once per path.
+  if (ctx.config.store_nee_ratio) y0.nee_ratio = n > 0 ? static_cast<float>(next_event_ratio(y0, path[1])) : 1.f;
   return n + 1;
 }
 
 // ---------------------------------------------------------------------------------------------
 
-double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
-                  const Vertex* light_end, const Vertex* camera_end, Technique tau) {
+namespace {
+
+// The densities a connection changes (see mis_weight()): the two vertices on each side of the new
+// edge see new neighbours, strategy 1 has its own origin density, and the next-event ratio of the
+// path's first two vertices.
+struct Patch {
+  float light_s = 0.f;    // x_s's pdf_light (t >= 1)
+  float light_s1 = 0.f;   // x_{s+1}'s pdf_light (t >= 2)
+  float camera_s1 = 0.f;  // x_{s-1}'s pdf_camera (s >= 1)
+  float camera_s2 = 0.f;  // x_{s-2}'s pdf_camera (s >= 2)
+  float light_0 = 0.f;    // x_0's pdf_light (s = 1)
+  double nee_ratio = 1.0;
+};
+
+// Scratch space of one weight: on the stack for paths of up to kInlineVertices vertices (maxdepth
+// 30), per thread beyond.
+constexpr int kInlineVertices = 32;
+
+template <class T, int Tag>
+struct Scratch {
+  union {
+    T inline_[kInlineVertices];
+  };
+  T* data;
+  explicit Scratch(int n) {
+    if (n <= kInlineVertices) {
+      data = inline_;
+    } else {
+      thread_local std::vector<T> heap;
+      if (static_cast<int>(heap.size()) < n) heap.resize(n);
+      data = heap.data();
+    }
+  }
+  ~Scratch() {}
+};
+
+// Next-event ratio of a path whose first vertices are light[0], light[1] (s >= 2): stored on the
+// light subpath by light_subpath().
+double cached_nee_ratio(const Vertex* light, int s, const Vertex* light_end, const Vertex& x0, const Vertex& x1) {
+  if (!(light_end && s == 2) && !std::isnan(light[0].nee_ratio)) return light[0].nee_ratio;
+  return next_event_ratio(x0, x1);
+}
+
+double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
+                   const Vertex* light_end, const Vertex* camera_end, Technique tau, const Patch& patch) {
   if (s + t == 2) return 1.0;
   int k = s + t - 1;
   auto L = [&](int i) -> const Vertex& { return (i == s - 1 && light_end) ? *light_end : light[i]; };
   auto C = [&](int j) -> const Vertex& { return (j == t - 1 && camera_end) ? *camera_end : camera[j]; };
 
-  thread_local std::vector<MisVertex> mv;
-  thread_local std::vector<double> ratios;
-  mv.assign(k + 1, MisVertex{});
-  ratios.assign(k + 1, 0.0);
-  for (int i = 0; i < s; ++i) mv[i] = {L(i).pdf_fwd, L(i).pdf_rev, L(i).delta};
-  for (int i = s; i <= k; ++i) {
-    const Vertex& v = C(k - i);
-    mv[i] = {v.pdf_rev, v.pdf_fwd, v.delta};
+  Scratch<MisVertex, 0> mv_scratch(k + 1);
+  Scratch<double, 1> ratio_scratch(k + 1);
+  MisVertex* mv = mv_scratch.data;
+  std::span<double> ratios(ratio_scratch.data, k + 1);
+  const int s_own = light_end ? s - 1 : s, t_own = camera_end ? t - 1 : t;  // vertices from the subpaths
+  for (int i = 0; i < s_own; ++i) mv[i] = MisVertex{light[i].pdf_fwd, light[i].pdf_rev, light[i].delta};
+  if (s_own < s) mv[s - 1] = MisVertex{light_end->pdf_fwd, light_end->pdf_rev, light_end->delta};
+  for (int j = 0; j < t_own; ++j) mv[k - j] = MisVertex{camera[j].pdf_rev, camera[j].pdf_fwd, camera[j].delta};
+  if (t_own < t) mv[s] = MisVertex{camera_end->pdf_rev, camera_end->pdf_fwd, camera_end->delta};
+  // The connected vertices scatter through their non-delta parts; their neighbours' densities change.
+  if (s > 0) {
+    mv[s - 1].delta = false;
+    mv[s - 1].pdf_camera = patch.camera_s1;
   }
-
-  // The densities the connection changes: the two vertices on each side of the new edge see new
-  // neighbours, and the connected vertices scatter through their non-delta parts.
-  const Vertex* qs = s > 0 ? &L(s - 1) : nullptr;
-  const Vertex* qs_prev = s > 1 ? &L(s - 2) : nullptr;
-  const Vertex* pt = t > 0 ? &C(t - 1) : nullptr;
-  const Vertex* pt_prev = t > 1 ? &C(t - 2) : nullptr;
-  if (qs) mv[s - 1].delta = false;
-  if (pt) {
+  if (t > 0) {
     mv[s].delta = false;
-    mv[s].pdf_light = qs ? pdf_area(ctx, qs_prev, *qs, *pt) : pdf_light_origin(ctx, *pt, pt_prev ? *pt_prev : *pt);
+    mv[s].pdf_light = patch.light_s;
   }
-  if (pt_prev) mv[s + 1].pdf_light = qs ? pdf_area(ctx, qs, *pt, *pt_prev) : pdf_light_dir(*pt, *pt_prev);
-  if (qs) mv[s - 1].pdf_camera = pdf_area(ctx, pt_prev, *pt, *qs);
-  if (qs_prev) mv[s - 2].pdf_camera = pdf_area(ctx, pt, *qs, *qs_prev);
-  if (s == 1) mv[0].pdf_light = pdf_light_origin(ctx, *qs, *pt);
+  if (t > 1) mv[s + 1].pdf_light = patch.light_s1;
+  if (s > 1) mv[s - 2].pdf_camera = patch.camera_s2;
+  if (s == 1) mv[0].pdf_light = patch.light_0;
 
-  const Vertex& x0 = s > 0 ? L(0) : *pt;
-  const Vertex& x1 = s > 1 ? L(1) : (s == 1 ? *pt : *pt_prev);
+  const Vertex& x0 = s > 0 ? L(0) : C(t - 1);
   MisPath path;
-  path.vertices = mv;
+  path.vertices = std::span<const MisVertex>(mv, k + 1);
   path.light_hittable = x0.light && !is_delta_light(x0.light->type());
-  path.nee_ratio = k >= 2 ? next_event_ratio(x0, x1) : 1.0;
+  path.nee_ratio = k >= 2 ? patch.nee_ratio : 1.0;
   strategy_density_ratios(path, s, ratios);
   if (!ctx.techniques || ctx.techniques->all_regular()) return mis_weight_from_ratios(ratios, s, ctx.config.heuristic);
 
   // Several techniques per strategy: strategy i's sum is sum_tau c_tau(i)^beta (mis.h).
   const TechniqueSet& ts = *ctx.techniques;
   auto X = [&](int m) -> const Vertex& { return m < s ? L(m) : C(k - m); };
-  thread_local std::vector<double> sums;
-  sums.assign(k + 1, 0.0);
+  Scratch<double, 2> sum_scratch(k + 1);
+  std::span<double> sums(sum_scratch.data, k + 1);
   double own = 1.0;
   for (int i = 0; i <= k; ++i) {
+    sums[i] = 0.0;
     if (ratios[i] == 0.0) continue;
     double sum = 0.0;
     if (i == 0) {
@@ -363,6 +420,73 @@ double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* 
     sums[i] = sum;
   }
   return mis_weight_from_ratios(ratios, s, ctx.config.heuristic, sums, own);
+}
+
+// Vertex::f() towards world direction wi (local wi_local), wi = direction_to(v, next).
+Rgb surface_f(const Vertex& v, const Vec3& wi, const Vec3& wi_local) {
+  if (leaks(v, v.wo, wi)) return Rgb(0.f);
+  Rgb value = v.bsdf->f(v.shading.to_local(v.wo), wi_local, ShadingContext{v.uv, v.mode});
+  if (v.mode == TransportMode::Importance) value *= shading_correction(v, v.wo, wi);
+  return value;
+}
+
+// Strategy (s, t) with s, t >= 2: joins light[s-1] and camera[t-1] with a shadow ray (the contribution
+// of pbrt-v3's ConnectBDPT: both throughputs, both BSDFs, the geometry term) and, when `patch` is given and the connection carries light, fills the
+// densities the MIS weight needs from the same directions. Returns 0 when occluded.
+Rgb connect_surfaces(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t, Patch* patch) {
+  const Vertex& qs = light[s - 1];
+  const Vertex& pt = camera[t - 1];
+  if (!qs.connectible() || !pt.connectible() || pt.kind != VertexKind::Surface) return Rgb(0.f);
+  // qs (s >= 2) and pt are surface vertices.
+  Vec3 w = direction_to(qs, pt);  // qs -> pt; direction_to(pt, qs) is exactly -w
+  Vec3 wq = qs.shading.to_local(w), wp = pt.shading.to_local(-w);
+  Rgb L = qs.beta * surface_f(qs, w, wq) * surface_f(pt, -w, wp) * pt.beta;
+  if (is_black(L)) return L;
+  Vec3 d = pt.p - qs.p;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.f)) return Rgb(0.f);
+  Vec3 wn = d / std::sqrt(dist2);
+  L *= std::abs(glm::dot(qs.ns, wn)) * std::abs(glm::dot(pt.ns, wn)) / dist2;
+  if (is_black(L) ||
+      ctx.scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng)))
+    return Rgb(0.f);
+  if (patch) {
+    const Vertex& qs_prev = light[s - 2];
+    const Vertex& pt_prev = camera[t - 2];
+    surface_pdf_pair(qs, qs_prev, qs.shading.to_local(direction_to(qs, qs_prev)), pt, wq, &patch->light_s,
+                     &patch->camera_s2);
+    surface_pdf_pair(pt, qs, wp, pt_prev, pt.shading.to_local(direction_to(pt, pt_prev)), &patch->light_s1,
+                     &patch->camera_s1);
+    patch->nee_ratio = s + t - 1 >= 2 ? cached_nee_ratio(light, s, nullptr, light[0], light[1]) : 1.0;
+  }
+  return L;
+}
+
+}  // namespace
+
+double mis_weight(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
+                  const Vertex* light_end, const Vertex* camera_end, Technique tau) {
+  if (s + t == 2) return 1.0;
+  int k = s + t - 1;
+  auto L = [&](int i) -> const Vertex& { return (i == s - 1 && light_end) ? *light_end : light[i]; };
+  auto C = [&](int j) -> const Vertex& { return (j == t - 1 && camera_end) ? *camera_end : camera[j]; };
+
+  // The densities the connection changes: the two vertices on each side of the new edge see new
+  // neighbours, and the connected vertices scatter through their non-delta parts.
+  const Vertex* qs = s > 0 ? &L(s - 1) : nullptr;
+  const Vertex* qs_prev = s > 1 ? &L(s - 2) : nullptr;
+  const Vertex* pt = t > 0 ? &C(t - 1) : nullptr;
+  const Vertex* pt_prev = t > 1 ? &C(t - 2) : nullptr;
+  Patch patch;
+  if (pt) patch.light_s = qs ? pdf_area(ctx, qs_prev, *qs, *pt) : pdf_light_origin(ctx, *pt, pt_prev ? *pt_prev : *pt);
+  if (pt_prev) patch.light_s1 = qs ? pdf_area(ctx, qs, *pt, *pt_prev) : pdf_light_dir(*pt, *pt_prev);
+  if (qs) patch.camera_s1 = pdf_area(ctx, pt_prev, *pt, *qs);
+  if (qs_prev) patch.camera_s2 = pdf_area(ctx, pt, *qs, *qs_prev);
+  if (s == 1) patch.light_0 = pdf_light_origin(ctx, *qs, *pt);
+  const Vertex& x0 = s > 0 ? L(0) : *pt;
+  const Vertex& x1 = s > 1 ? L(1) : (s == 1 ? *pt : *pt_prev);
+  if (k >= 2) patch.nee_ratio = s > 1 ? cached_nee_ratio(light, s, light_end, x0, x1) : next_event_ratio(x0, x1);
+  return weight_with(ctx, light, s, camera, t, light_end, camera_end, tau, patch);
 }
 
 Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t, PathSampler& ps,
@@ -412,11 +536,9 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     cam.kind = VertexKind::Camera;
     cam.p = cw->p_lens;
     cam.beta = cw->We / cw->pdf;
-    {
-      float pdf_pos, pdf_dir;
-      scene.camera().pdf_we(Ray{cam.p, -cw->wi}, &pdf_pos, &pdf_dir);
-      cam.pdf_fwd = pdf_pos;
-    }
+    float pdf_pos, pdf_dir;
+    scene.camera().pdf_we(Ray{cam.p, -cw->wi}, &pdf_pos, &pdf_dir);
+    cam.pdf_fwd = pdf_pos;
     c.has_sampled = true;
     if (qs.kind == VertexKind::Surface)
       c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
@@ -428,7 +550,19 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     }
     c.splat = true;
     c.p_raster = cw->p_raster;
-    finish(nullptr, &cam);
+    if (!weighted || s + t == 2) {
+      c.weight = 1.0;
+      c.weighted = c.L;
+      return c;
+    }
+    // s >= 2: qs is a surface vertex with a predecessor. The lens density towards qs is the one
+    // pdf_we() just gave for the direction lens -> qs.
+    Patch patch;
+    surface_pdf_pair(qs, light[s - 2], cam, &patch.light_s, &patch.camera_s2);
+    patch.camera_s1 = convert_density(pdf_dir, cam, qs);
+    patch.nee_ratio = cached_nee_ratio(light, s, nullptr, light[0], light[1]);
+    c.weight = weight_with(ctx, light, s, camera, t, nullptr, &cam, Technique::Regular, patch);
+    c.weighted = c.L * static_cast<float>(c.weight);
     return c;
   }
 
@@ -450,20 +584,50 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     lv.w_light = -ls->wi;
     lv.beta = ls->L / (ls->pdf * sl->pmf);
     lv.mode = TransportMode::Importance;
-    lv.pdf_fwd = pdf_light_origin(ctx, lv, pt);
+    // Both emission densities of the sampled point from one pdf_le() call (pdf_light_origin() and
+    // pdf_light_dir() towards pt).
+    float pdf_pos = 0.f, pdf_dir = 0.f, to_pt = 0.f;
+    LightType type = sl->light->type();
+    if (lv.infinite) {
+      sl->light->pdf_le(Ray{lv.p, lv.w_light}, Vec3(0.f), &pdf_pos, &pdf_dir);
+      to_pt = pt.on_surface() ? pdf_pos * std::abs(glm::dot(pt.ng, lv.w_light)) : pdf_pos;
+    } else {
+      sl->light->pdf_le(Ray{lv.p, direction_to(lv, pt)}, lv.ng, &pdf_pos, &pdf_dir);
+      to_pt = convert_density(pdf_dir, lv, pt);
+    }
+    float pmf = ctx.lights.pmf(sl->light);
+    lv.pdf_fwd = type == LightType::Area ? pmf * pdf_pos : type == LightType::Infinite ? pmf * pdf_dir : pmf;
     c.has_sampled = true;
-    c.L = pt.beta * pt.f(lv) * lv.beta * std::abs(glm::dot(ls->wi, pt.ns));
+    Vec3 w = direction_to(pt, lv);
+    Vec3 wl = pt.shading.to_local(w);
+    c.L = pt.beta * surface_f(pt, w, wl) * lv.beta * std::abs(glm::dot(ls->wi, pt.ns));
     if (is_black(c.L) || scene.occluded(shadow_ray(pt, ls->p_light, ls->n_light))) {
       c.L = Rgb(0.f);
       return c;
     }
-    finish(&lv, nullptr);
+    if (!weighted) {
+      c.weight = 1.0;
+      c.weighted = c.L;
+      return c;
+    }
+    Patch patch;
+    patch.light_s = to_pt;
+    patch.light_0 = lv.pdf_fwd;
+    surface_pdf_pair(pt, lv, wl, camera[t - 2], pt.shading.to_local(direction_to(pt, camera[t - 2])), &patch.light_s1,
+                     &patch.camera_s1);
+    // sample_li() drew lv with the density next_event_ratio() asks pdf_li() for.
+    patch.nee_ratio = next_event_ratio_applies(lv, pt) ? next_event_ratio_from(lv, pt, ls->pdf, pdf_pos) : 1.0;
+    c.weight = weight_with(ctx, light, s, camera, t, &lv, nullptr, Technique::Regular, patch);
+    c.weighted = c.L * static_cast<float>(c.weight);
     return c;
   }
 
   if (ts && !ts->connect) return c;
-  c.L = connect_vertices(scene, light[s - 1], pt);
-  finish(nullptr, nullptr);
+  Patch patch;
+  c.L = connect_surfaces(ctx, light, s, camera, t, weighted ? &patch : nullptr);
+  if (is_black(c.L)) return c;
+  c.weight = weighted ? weight_with(ctx, light, s, camera, t, nullptr, nullptr, Technique::Regular, patch) : 1.0;
+  c.weighted = c.L * static_cast<float>(c.weight);
   return c;
 }
 
@@ -471,10 +635,11 @@ Connection connect_cached(const Context& ctx, const Vertex* light, int s, const 
                           Technique tau, double factor) {
   Connection c;
   if (s < 2 || t < 2 || !(factor > 0.0)) return c;
-  c.L = connect_vertices(ctx.scene, light[s - 1], camera[t - 1]);
+  Patch patch;
+  c.L = connect_surfaces(ctx, light, s, camera, t, &patch);
   if (is_black(c.L)) return c;
   c.L /= static_cast<float>(factor);
-  c.weight = mis_weight(ctx, light, s, camera, t, nullptr, nullptr, tau);
+  c.weight = weight_with(ctx, light, s, camera, t, nullptr, nullptr, tau, patch);
   c.weighted = c.L * static_cast<float>(c.weight);
   return c;
 }

@@ -30,6 +30,7 @@
 #include <penumbra/scene.h>
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -67,6 +68,10 @@ struct Vertex {
   bool delta = false;     // scattered specularly towards the next vertex
   bool infinite = false;  // a direction rather than a point (escaped camera ray, environment, distant)
   TransportMode mode = TransportMode::Radiance;
+  // Light endpoints traced by light_subpath(): next_event_ratio(path[0], path[1]), which every
+  // connection with s >= 2 light vertices needs for its MIS weight (NaN: not known, computed when
+  // needed). Fits in the padding after `mode`.
+  float nee_ratio = std::numeric_limits<float>::quiet_NaN();
 
   bool on_surface() const { return ng != Vec3(0.f); }
   /// Whether a deterministic connection can end here (it needs a non-delta scattering or emission).
@@ -77,12 +82,16 @@ struct Vertex {
 };
 
 /// Unit direction from `from` towards `to` (towards the light for vertices at infinity).
-Vec3 direction_to(const Vertex& from, const Vertex& to);
+inline Vec3 direction_to(const Vertex& from, const Vertex& to) {
+  if (to.infinite) return -to.w_light;
+  return glm::normalize(to.p - from.p);
+}
 
 struct Config {
   int max_depth = 5;  // bounces: strategies with s + t - 2 <= max_depth
   int rr_depth = 3;   // bounces of a subpath before Russian roulette may end it
   MisHeuristic heuristic = MisHeuristic::Power;
+  bool store_nee_ratio = true;  // light_subpath() fills Vertex::nee_ratio (MIS needs it; light tracing does not)
 };
 
 /// Reads and checks the parameters bdpt and lighttracing share: "maxdepth", "rrdepth" and
@@ -142,6 +151,34 @@ struct Context {
   const LightChooser& lights;
   Config config;
   const TechniqueSet* techniques = nullptr;  // null: every per-sample technique, nothing cached
+};
+
+/// Scratch storage for one subpath of `n` vertices, left uninitialised (the walks write every vertex
+/// they return): on the stack up to kInline vertices (maxdepth 14), else a per-thread buffer (one per
+/// Tag, so that a sample's two subpaths do not share it).
+template <int Tag>
+class SubpathStorage {
+ public:
+  static constexpr int kInline = 16;
+  explicit SubpathStorage(int n) {
+    if (n <= kInline) {
+      data_ = inline_;
+    } else {
+      thread_local std::vector<Vertex> heap;
+      if (static_cast<int>(heap.size()) < n) heap.resize(n);
+      data_ = heap.data();
+    }
+  }
+  ~SubpathStorage() {}
+  SubpathStorage(const SubpathStorage&) = delete;
+  SubpathStorage& operator=(const SubpathStorage&) = delete;
+  Vertex* data() { return data_; }
+
+ private:
+  union {
+    Vertex inline_[kInline];
+  };
+  Vertex* data_;
 };
 
 /// Traces the camera subpath of `ray` into path[0 .. max_depth + 1]; returns the vertex count.

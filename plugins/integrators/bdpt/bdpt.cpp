@@ -208,10 +208,9 @@ class BdptIntegrator final : public SampleIntegrator {
 
   Rgb sample(const Scene& scene, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
     const int max_depth = config_.max_depth;
-    thread_local std::vector<Vertex> camera_path, own_light_path;
-    camera_path.resize(max_depth + 2);
-    own_light_path.resize(max_depth + 1);
     if (!px.ray) return Rgb(0.f);
+    SubpathStorage<0> camera_path(max_depth + 2);
+    SubpathStorage<1> own_light_path(max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);
     int nc = camera_subpath(*ctx_, *px.ray, ps, camera_path.data());
     // The pixel's light subpath: from the iteration's cache when it holds it (the same path).
@@ -225,11 +224,26 @@ class BdptIntegrator final : public SampleIntegrator {
       nl = light_subpath(*ctx_, ps, own_light_path.data());
     }
     StrategyImages* images = visualize_ ? &images_->local() : nullptr;
+    // Strategies whose connection would end at a vertex that cannot be connected (specular-only, an
+    // escaped camera ray) give nothing: skipped here, with the tests connect() would make itself,
+    // rather than set up a Connection each. Bit i: vertex i (beyond 64 vertices connect() decides).
+    const Vertex* camera = camera_path.data();
+    uint64_t camera_ok = 0, light_ok = 0, emitter = 0;
+    for (int i = 0; i < std::min(nc, 64); ++i) {
+      if (camera[i].kind != VertexKind::Light && camera[i].connectible()) camera_ok |= uint64_t(1) << i;
+      if (camera[i].light || camera[i].kind == VertexKind::Light) emitter |= uint64_t(1) << i;
+    }
+    for (int i = 0; i < std::min(nl, 64); ++i)
+      if (light_path[i].connectible()) light_ok |= uint64_t(1) << i;
+    auto has = [](uint64_t mask, int i) { return i >= 64 || ((mask >> i) & 1); };
     Rgb L(0.f);
     for (int t = 1; t <= nc; ++t)
       for (int s = 0; s <= nl; ++s) {
         int depth = s + t - 2;
         if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
+        if (s == 0 ? !has(emitter, t - 1)
+                   : (t >= 2 && !has(camera_ok, t - 1)) || ((s >= 2 || t == 1) && !has(light_ok, s - 1)))
+          continue;
         Connection c = connect(*ctx_, light_path, s, camera_path.data(), t, ps);
         if (is_black(c.L)) continue;
         if (c.splat)

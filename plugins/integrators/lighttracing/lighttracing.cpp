@@ -34,8 +34,7 @@ class LightTracingIntegrator final : public SampleIntegrator {
   }
 
   Rgb sample(const Scene&, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
-    thread_local std::vector<Vertex> light_path;
-    light_path.resize(config_.max_depth + 1);
+    SubpathStorage<0> light_path(config_.max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);
     int nl = light_subpath(*ctx_, ps, light_path.data());
     for (int s = 1; s <= nl; ++s) {
@@ -63,6 +62,7 @@ Object* create(const CreateContext& ctx) {
   const ParamSet& p = ctx.params;
   bool uniform_lights = false;
   Config config = read_subpath_config(p, &uniform_lights);
+  config.store_nee_ratio = false;  // unweighted: no MIS
   return new LightTracingIntegrator(config, uniform_lights);
 }
 
