@@ -21,6 +21,12 @@ struct CameraPathResult {
 /// the pixel sample and drawn the pixel (2) and lens (2) dimensions. Then 10 dimensions per bounce
 /// (light 1 + 2, direct-light BSDF sample 1 + 2, continuation 1 + 2, roulette 1), drawn whether used
 /// or not so that quasi-random samplers keep their dimensions aligned across paths.
-CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth);
+/// `rays_find_lights` is rays_can_find_lights(scene): false skips the BSDF-sampled direct-light ray,
+/// which could find no emitter.
+CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth,
+                                   bool rays_find_lights = true);
+
+/// Whether any light can be hit by a ray: an area or infinite light (not only point, spot and distant).
+bool rays_can_find_lights(const Scene& scene);
 
 }  // namespace penumbra::sppm

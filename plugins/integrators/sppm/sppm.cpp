@@ -110,6 +110,7 @@ class SppmIntegrator final : public SampleIntegrator {
   uint64_t photons_ = 0, photon_stream_ = 0;
   double quantum_ = 1.0, inv_quantum_ = 1.0;
   bool trace_photons_ = false;
+  bool rays_find_lights_ = true;    // false: only delta lights, no BSDF-sampled direct-light ray
   std::vector<VisiblePoint> vps_;
   std::vector<Vec3> vp_p_;
   std::vector<float> vp_radius_;    // 0 where a pixel has no visible point this iteration
@@ -151,6 +152,7 @@ void SppmIntegrator::begin_render(RenderContext& ctx) {
   inv_quantum_ = 1.0 / quantum_;
   // One bounce is all direct light; photons start to matter from two.
   trace_photons_ = max_depth_ >= 2 && photons_ > 0 && total_power > 0.0;
+  rays_find_lights_ = rays_can_find_lights(scene);
   vps_.assign(n_pixels, VisiblePoint{});
   vp_p_.assign(n_pixels, Vec3(0.f));
   vp_radius_.assign(n_pixels, 0.f);
@@ -171,7 +173,7 @@ Rgb SppmIntegrator::sample(const Scene& scene, const PixelSample& ps, Sampler& s
   vp_radius_[i] = 0.f;
   vp_Ld_[i] = Rgb(0.f);
   if (!ps.ray) return Rgb(0.f);
-  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_);
+  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_, rays_find_lights_);
   vp_Ld_[i] = r.Ld;
   bool valid = r.vp.bsdf && is_finite(r.p) && is_finite(r.vp.beta) && !is_black(r.vp.beta);
   if (!valid) return Rgb(0.f);
