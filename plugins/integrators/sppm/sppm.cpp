@@ -26,10 +26,10 @@
 // maxdepth - 1 - d bounces, so the image converges to exactly what "path" renders with the same
 // maxdepth (pbrt lets photons add up to maxdepth - 1 bounces whatever d is).
 //
-// Memory per pixel: visible point 80 B, its position and gather radius 16 B, statistics 64 B and
-// photon accumulator 32 B (192 B), plus the grid: 8 B per cell a point's disk overlaps (12 to 27
-// cells, as cells are one maximum radius wide: 100 to 220 B) and about 10 B of buckets and offsets.
-// About 300 to 420 B in all; photons are never stored. Deterministic: a fixed seed gives the same
+// Memory per pixel: visible point 80 B, its position and gather radius 16 B, statistics 64 B,
+// photon accumulator 32 B and gather point 72 B (both in the grid's slot order), plus the grid: a
+// 16 B slot (position and radius), a 4 B point index, 4 B of bucket during the build and 4 to 8 B
+// of buckets. About 290 to 300 B in all; photons are never stored. Deterministic: a fixed seed gives the same
 // image bit for bit, whatever the number of threads (see PhotonAccumulator).
 #include "camera_pass.h"
 #include "photon_tracer.h"
