@@ -29,7 +29,7 @@ struct DirectSamples {
 // (power heuristic); the BSDF ray counts any emitter it finds, whose light-sampling density is
 // pmf(light) * pdf_li, exactly as in the path integrator.
 Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
-                 const Scene& scene, const DirectSamples& u) {
+                 const Scene& scene, const DirectSamples& u, bool rays_find_lights) {
   Rgb L(0.f);
   LightSampleContext lctx{si.p, si.ng};
   if (std::optional<SampledLight> sl = scene.sample_light(u.u_light)) {
@@ -46,6 +46,9 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
     }
   }
 
+  // With only point, spot and distant lights a BSDF-sampled ray finds no emitter: it would add
+  // nothing, so it is not traced (its random numbers are drawn all the same).
+  if (!rays_find_lights) return L;
   std::optional<BsdfSample> bs = bsdf.sample_f(wo, u.u_lobe, u.u_dir, sctx);
   // A specular lobe cannot meet light sampling; the path continues through it instead (or, at a
   // visible point, that lobe is not followed, as in pbrt).
@@ -93,7 +96,14 @@ int draws_until_not_specular(const Bsdf& bsdf, const Vec3& wo, const ShadingCont
 
 }  // namespace
 
-CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth) {
+bool rays_can_find_lights(const Scene& scene) {
+  for (const Light* light : scene.lights())
+    if (!is_delta_light(light->type())) return true;
+  return !scene.infinite_lights().empty();
+}
+
+CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth,
+                                   bool rays_find_lights) {
   CameraPathResult out;
   Ray ray = camera_ray;
   float distance = 0.f;
@@ -124,7 +134,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     if (flags == 0) break;
     Vec3 wo = si->shading.to_local(si->wo);
     ShadingContext sctx{si->uv, TransportMode::Radiance};
-    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du);
+    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find_lights);
 
     // The continuation; a BSDF with diffuse and delta lobes needs it for the decision below.
     const bool diffuse = flags & BsdfDiffuse, has_delta = flags & BsdfSpecular;

@@ -22,6 +22,12 @@ struct CameraPathResult {
 /// (light 1 + 2, direct-light BSDF sample 1 + 2, continuation 1 + 2, roulette 1), drawn whether used
 /// or not so that quasi-random samplers keep their dimensions aligned across paths. A visible point
 /// on a BSDF with delta and diffuse lobes draws 3 more per extra BSDF sample after the last bounce's.
-CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth);
+/// `rays_find_lights` is rays_can_find_lights(scene): false skips the BSDF-sampled direct-light ray,
+/// which could find no emitter.
+CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth,
+                                   bool rays_find_lights = true);
+
+/// Whether any light can be hit by a ray: an area or infinite light (not only point, spot and distant).
+bool rays_can_find_lights(const Scene& scene);
 
 }  // namespace penumbra::sppm

@@ -26,10 +26,10 @@
 // maxdepth - 1 - d bounces, so the image converges to exactly what "path" renders with the same
 // maxdepth (pbrt lets photons add up to maxdepth - 1 bounces whatever d is).
 //
-// Memory per pixel: visible point 80 B, its position and gather radius 16 B, statistics 64 B and
-// photon accumulator 32 B (192 B), plus the grid: 8 B per cell a point's disk overlaps (12 to 27
-// cells, as cells are one maximum radius wide: 100 to 220 B) and about 10 B of buckets and offsets.
-// About 300 to 420 B in all; photons are never stored. Deterministic: a fixed seed gives the same
+// Memory per pixel: visible point 80 B, its position and gather radius 16 B, statistics 64 B,
+// photon accumulator 32 B and gather point 72 B (both in the grid's slot order), plus the grid: a
+// 16 B slot (position and radius), a 4 B point index, 4 B of bucket during the build and 4 to 8 B
+// of buckets. About 290 to 300 B in all; photons are never stored. Deterministic: a fixed seed gives the same
 // image bit for bit, whatever the number of threads (see PhotonAccumulator).
 #include "camera_pass.h"
 #include "photon_tracer.h"
@@ -64,6 +64,8 @@ constexpr uint64_t kDefaultMaxPhotons = uint64_t{1} << 18;
 // Photons traced between two looks at the time budget (a photon that lands among many visible
 // points, as with a radius near the scene size, can take a millisecond).
 constexpr uint64_t kPhotonBatch = 16;
+// Visible points a photon hit collects (and prefetches) before it deposits into them.
+constexpr int kGatherBatch = 64;
 
 class SppmIntegrator final : public SampleIntegrator {
  public:
@@ -92,6 +94,7 @@ class SppmIntegrator final : public SampleIntegrator {
 
  private:
   void choose_initial_radius();
+  void build_gather_points();
   void photon_pass(RenderContext& ctx, uint32_t iteration);
 
   int max_depth_;
@@ -107,12 +110,17 @@ class SppmIntegrator final : public SampleIntegrator {
   uint64_t photons_ = 0, photon_stream_ = 0;
   double quantum_ = 1.0, inv_quantum_ = 1.0;
   bool trace_photons_ = false;
+  bool rays_find_lights_ = true;    // false: only delta lights, no BSDF-sampled direct-light ray
   std::vector<VisiblePoint> vps_;
   std::vector<Vec3> vp_p_;
   std::vector<float> vp_radius_;    // 0 where a pixel has no visible point this iteration
   std::vector<Rgb> vp_Ld_;          // this iteration's camera-side light, kept until the pass is whole
   std::vector<float> vp_footprint_; // first iteration only: the pixel footprint at the visible point
   std::vector<PixelStatistics> stats_;
+  // In the grid's slot order (VisiblePointGrid::point_of), rebuilt with the grid: what a photon needs
+  // at a visible point, and the point's photon sums. Points of one cell lie together, so a photon's
+  // neighbours share cache lines instead of each costing a miss in pixel order.
+  std::vector<GatherPoint> gather_;
   std::unique_ptr<PhotonAccumulator[]> acc_;
   VisiblePointGrid grid_;
   int iterations_ = 0;              // complete iterations in the statistics
@@ -144,6 +152,7 @@ void SppmIntegrator::begin_render(RenderContext& ctx) {
   inv_quantum_ = 1.0 / quantum_;
   // One bounce is all direct light; photons start to matter from two.
   trace_photons_ = max_depth_ >= 2 && photons_ > 0 && total_power > 0.0;
+  rays_find_lights_ = rays_can_find_lights(scene);
   vps_.assign(n_pixels, VisiblePoint{});
   vp_p_.assign(n_pixels, Vec3(0.f));
   vp_radius_.assign(n_pixels, 0.f);
@@ -164,7 +173,7 @@ Rgb SppmIntegrator::sample(const Scene& scene, const PixelSample& ps, Sampler& s
   vp_radius_[i] = 0.f;
   vp_Ld_[i] = Rgb(0.f);
   if (!ps.ray) return Rgb(0.f);
-  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_);
+  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_, rays_find_lights_);
   vp_Ld_[i] = r.Ld;
   bool valid = r.vp.bsdf && is_finite(r.p) && is_finite(r.vp.beta) && !is_black(r.vp.beta);
   if (!valid) return Rgb(0.f);
@@ -199,6 +208,18 @@ void SppmIntegrator::choose_initial_radius() {
   vp_footprint_.shrink_to_fit();
 }
 
+// The visible points in the grid's slot order, so that the points a photon finds lie together.
+void SppmIntegrator::build_gather_points() {
+  const size_t n = grid_.node_count();
+  if (gather_.size() < n) gather_.resize(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& b) {
+    for (size_t s = b.begin(); s < b.end(); ++s) {
+      const VisiblePoint& vp = vps_[grid_.point_of(static_cast<uint32_t>(s))];
+      gather_[s] = GatherPoint{vp.shading, vp.wo, vp.uv, vp.bsdf, vp.max_photon_depth};
+    }
+  });
+}
+
 // Photon pass: each photon has its own random stream; deposits are order-independent integers.
 // Batches of photons, so a time budget that runs out stops the pass within one batch per thread.
 void SppmIntegrator::photon_pass(RenderContext& ctx, uint32_t iteration) {
@@ -213,16 +234,33 @@ void SppmIntegrator::photon_pass(RenderContext& ctx, uint32_t iteration) {
         Pcg32 rng = photon_rng(photon_stream_, iteration, k);
         trace_photon(scene, rng, max_depth_, [&](const SurfaceInteraction& hit, const Vec3& wi, const Rgb& beta, int depth) {
           if (depth == 0) return;  // direct light: the camera pass sampled it
-          grid_.for_each_within(hit.p, [&](uint32_t i) {
-            const VisiblePoint& vp = vps_[i];
-            if (depth > vp.max_photon_depth) return;
-            Rgb phi = beta * vp.bsdf->f(vp.wo, vp.shading.to_local(wi), ShadingContext{vp.uv, TransportMode::Radiance});
+          auto gather = [&](uint32_t slot) {
+            const GatherPoint& g = gather_[slot];
+            if (depth > g.max_photon_depth) return;
+            Rgb phi = beta * g.bsdf->f(g.wo, g.shading.to_local(wi), ShadingContext{g.uv, TransportMode::Radiance});
             if (!is_finite(phi)) {
+              uint32_t i = grid_.point_of(slot);
               ctx.report_nonfinite(Point2i(static_cast<int>(i % res_.x), static_cast<int>(i / res_.x)));
               return;
             }
-            acc_[i].add(phi, inv_quantum_);
+            acc_[slot].add(phi, inv_quantum_);
+          };
+          // Two steps: find the points and start loading their data, then gather. The atomic adds
+          // order memory like fences, so gathering while scanning would wait for each point's data
+          // in turn; this way the loads overlap.
+          uint32_t found[kGatherBatch];
+          int n_found = 0;
+          grid_.for_each_entry_within(hit.p, [&](uint32_t slot) {
+            if (n_found == kGatherBatch) {
+              for (int j = 0; j < n_found; ++j) gather(found[j]);
+              n_found = 0;
+            }
+            __builtin_prefetch(&gather_[slot]);
+            __builtin_prefetch(reinterpret_cast<const char*>(&gather_[slot]) + 64);
+            __builtin_prefetch(&acc_[slot], 1);
+            found[n_found++] = slot;
           });
+          for (int j = 0; j < n_found; ++j) gather(found[j]);
         });
       }
       traced.fetch_add(k1 - k0, std::memory_order_relaxed);
@@ -246,30 +284,38 @@ void SppmIntegrator::end_pass(RenderContext& ctx, const Pass& pass) {
     grid_built_ = true;
     // Without visible points (the camera sees only sky or glass) the photons would find nothing.
     if (grid_.bucket_count() > 0) {
+      build_gather_points();
       photon_pass(ctx, pass.first_index);
       photons_found = true;
     }
   }
   if (!photons_found && trace_photons_) emitted_ += static_cast<double>(photons_);
-  // Progressive update of N, r and tau (the visible point's throughput applies to all its photons),
-  // and the camera-side light of the whole iteration.
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n_pixels, 1024), [&](const tbb::blocked_range<size_t>& b) {
+  // The camera-side light of the whole iteration.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n_pixels, 4096), [&](const tbb::blocked_range<size_t>& b) {
     for (size_t i = b.begin(); i < b.end(); ++i) {
       const Rgb& Ld = vp_Ld_[i];
       if (is_finite(Ld))
         for (int c = 0; c < 3; ++c) stats_[i].Ld[c] += Ld[c];
       else
         ctx.report_nonfinite(Point2i(static_cast<int>(i % res_.x), static_cast<int>(i / res_.x)));
-      int64_t M = acc_[i].M.load(std::memory_order_relaxed);
-      if (M > 0) {
-        double Phi[3];
-        for (int c = 0; c < 3; ++c)
-          Phi[c] = static_cast<double>(acc_[i].phi[c].load(std::memory_order_relaxed)) * quantum_ * vps_[i].beta[c];
-        update_statistics(stats_[i], static_cast<double>(M), Phi, alpha_);
-        acc_[i].reset();
-      }
     }
   });
+  // Progressive update of N, r and tau (the visible point's throughput applies to all its photons),
+  // over the grid's slots: each holds one pixel's visible point and its photon sums.
+  if (photons_found)
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid_.node_count(), 4096), [&](const tbb::blocked_range<size_t>& b) {
+      for (size_t s = b.begin(); s < b.end(); ++s) {
+        PhotonAccumulator& acc = acc_[s];
+        int64_t M = acc.M.load(std::memory_order_relaxed);
+        if (M <= 0) continue;
+        size_t i = grid_.point_of(static_cast<uint32_t>(s));
+        double Phi[3];
+        for (int c = 0; c < 3; ++c)
+          Phi[c] = static_cast<double>(acc.phi[c].load(std::memory_order_relaxed)) * quantum_ * vps_[i].beta[c];
+        update_statistics(stats_[i], static_cast<double>(M), Phi, alpha_);
+        acc.reset();
+      }
+    });
   ++iterations_;
 }
 

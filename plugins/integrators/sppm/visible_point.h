@@ -27,6 +27,16 @@ struct VisiblePoint {
   int max_photon_depth = 0;
 };
 
+/// What a photon needs at a visible point (its throughput is applied at the update instead), copied
+/// into the grid's slot order each iteration: 72 bytes.
+struct GatherPoint {
+  Frame shading;
+  Vec3 wo{0.f};
+  Vec2 uv{0.f};
+  const Bsdf* bsdf = nullptr;
+  int max_photon_depth = 0;
+};
+
 /// Statistics that persist across iterations (pbrt's N, r, tau) plus the camera-side sum Ld.
 /// Doubles: they accumulate thousands of iterations.
 struct PixelStatistics {

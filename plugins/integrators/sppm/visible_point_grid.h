@@ -1,15 +1,19 @@
 // A hashed uniform grid over the visible points of one iteration, answering "which points have q
 // within their radius?" for every photon hit.
 //
-// Cells are at least as wide as the largest radius, so a point's disk overlaps at most 3x3x3 cells;
-// the point is listed in each of them. Only cells that hold points cost memory: cell coordinates are
-// hashed into a table with about one bucket per point, and each bucket heads a singly linked list of
-// nodes pushed lock-free with compare-exchange, so the build runs in parallel. Two cells of one point
-// may share a bucket; the point is then listed once for both, which keeps a photon from being counted
+// Each point is stored once, in the cell that holds its position; cells are a little over two largest
+// radii wide, so the points that can reach q lie in the cells that [q - R, q + R] overlaps: at most
+// 2 per axis, 8 in all (R is the largest radius, times 1.001 against rounding). Only cells that hold
+// points cost memory: cell coordinates are hashed into a table with one to two buckets per point, and
+// the points are counting-sorted by bucket, so a bucket's points lie next to each other. Each entry
+// keeps the point's position and radius inline (16 bytes), so a query scans contiguous memory and
+// follows no pointer until a point is within its radius (the earlier layout, a linked list of point
+// indices per bucket, took one dependent cache miss per candidate and half the photon pass).
+// Two of a query's cells may share a bucket; the bucket is then scanned once, so no point is reported
 // twice. Collisions with other cells cost time, never correctness: the query tests the distance.
 //
-// Memory: 4 bytes per bucket (1 to 2 per point), 8 bytes per node (1 to 27 per point) and 4 bytes per
-// point for the node offsets. The table and node arrays are kept between builds.
+// Memory: 4 bytes per bucket (1 to 2 per point) plus 24 bytes per point (16 for the entry, 4 for its
+// index, 4 for its bucket during the build). The arrays are kept between builds.
 #pragma once
 
 #include <penumbra/math.h>
@@ -33,12 +37,11 @@ class VisiblePointGrid {
   /// Cells per axis are capped so that coordinates pack into 21 bits; with a tiny radius in a large
   /// scene the cells then grow beyond the radius, which stays correct.
   static constexpr int kMaxCellsPerAxis = 1 << 20;
+  static constexpr double kCellReach = 2.0;
 
   /// Rebuilds the grid over points p[i] with gather radii r[i]; r[i] <= 0 (or non-finite) leaves point
-  /// i out. Both spans must stay alive and unchanged while the grid is queried.
+  /// i out. The grid copies what it needs: the spans may change after the build.
   void build(std::span<const Vec3> p, std::span<const float> r) {
-    p_ = p;
-    r_ = r;
     node_count_ = 0;
     Extent e = extent(p, r);
     if (e.count == 0) {
@@ -48,9 +51,10 @@ class VisiblePointGrid {
     active_ = true;
     Vec3 size = e.hi - e.lo;
     float widest = std::max(size.x, std::max(size.y, size.z));
-    // A little wider than the largest radius, so that a disk's box (2r wide) spans at most 3 cells
-    // per axis; coordinates are computed in double so that rounding cannot add a fourth.
-    cell_ = std::max(1.001 * e.max_radius, static_cast<double>(widest) / (kMaxCellsPerAxis - 2));
+    // A query looks h = 1.001 R either side of q; cells 2h wide make that at most 2 cells per axis.
+    // Coordinates are computed in double; the margin covers the rounding of the float distance test.
+    reach_ = 1.001 * e.max_radius;
+    cell_ = std::max(kCellReach * reach_, static_cast<double>(widest) / (kMaxCellsPerAxis - 2));
     if (!(cell_ > 0.0)) cell_ = 1.0;  // every disk is a point at one place
     inv_cell_ = 1.0 / cell_;
     origin_ = glm::dvec3(e.lo);
@@ -59,37 +63,49 @@ class VisiblePointGrid {
 
     size_t buckets = 1;
     while (buckets < e.count) buckets <<= 1;
-    if (buckets > bucket_capacity_) {
-      heads_ = std::make_unique<std::atomic<uint32_t>[]>(buckets);
-      bucket_capacity_ = buckets;
-    }
     bucket_mask_ = buckets - 1;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets, 4096), [&](const tbb::blocked_range<size_t>& b) {
-      for (size_t i = b.begin(); i < b.end(); ++i) heads_[i].store(kEnd, std::memory_order_relaxed);
+    if (buckets + 1 > start_.size()) start_ = std::vector<std::atomic<uint32_t>>(buckets + 1);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets + 1, 4096), [&](const tbb::blocked_range<size_t>& b) {
+      for (size_t i = b.begin(); i < b.end(); ++i) start_[i].store(0, std::memory_order_relaxed);
     });
 
-    // Count each point's distinct buckets, lay the nodes out by prefix sum, then link them.
-    first_node_.resize(p.size() + 1);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size(), 1024), [&](const tbb::blocked_range<size_t>& b) {
-      uint32_t tmp[kMaxCellsPerPoint];
-      for (size_t i = b.begin(); i < b.end(); ++i) first_node_[i + 1] = point_buckets(i, tmp);
-    });
-    first_node_[0] = 0;
-    for (size_t i = 0; i < p.size(); ++i) first_node_[i + 1] += first_node_[i];
-    node_count_ = first_node_[p.size()];
-    if (nodes_.size() < node_count_) nodes_.resize(node_count_);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size(), 1024), [&](const tbb::blocked_range<size_t>& b) {
-      uint32_t tmp[kMaxCellsPerPoint];
+    // Counting sort by bucket: each point's bucket and the buckets' sizes, an exclusive prefix sum,
+    // then every point goes to its bucket's next free slot (the order within a bucket does not matter:
+    // deposits are order-independent integer sums).
+    point_bucket_.resize(p.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size(), 4096), [&](const tbb::blocked_range<size_t>& b) {
       for (size_t i = b.begin(); i < b.end(); ++i) {
-        uint32_t n = point_buckets(i, tmp), node = first_node_[i];
-        for (uint32_t k = 0; k < n; ++k, ++node) {
-          nodes_[node].point = static_cast<uint32_t>(i);
-          std::atomic<uint32_t>& head = heads_[tmp[k]];
-          uint32_t old = head.load(std::memory_order_relaxed);
-          do {
-            nodes_[node].next = old;
-          } while (!head.compare_exchange_weak(old, node, std::memory_order_release, std::memory_order_relaxed));
+        if (!active_point(p[i], r[i])) {
+          point_bucket_[i] = kNone;
+          continue;
         }
+        glm::ivec3 c;
+        for (int k = 0; k < 3; ++k) c[k] = cell_coordinate(static_cast<double>(p[i][k]), k);
+        uint32_t bk = bucket(c);
+        point_bucket_[i] = bk;
+        start_[bk + 1].fetch_add(1, std::memory_order_relaxed);
+      }
+    });
+    uint32_t sum = 0;
+    for (size_t i = 1; i <= buckets; ++i) {
+      sum += start_[i].load(std::memory_order_relaxed);
+      start_[i].store(sum, std::memory_order_relaxed);
+    }
+    node_count_ = sum;
+    if (entries_.size() < node_count_) {
+      entries_.resize(node_count_);
+      index_.resize(node_count_);
+    }
+    // start_[b] serves as bucket b's cursor and ends at its end, which is bucket b + 1's start:
+    // afterwards the range of bucket b is [start_[b - 1], start_[b]) with start_[-1] = 0, so the
+    // table is read shifted by one (begin_of).
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size(), 4096), [&](const tbb::blocked_range<size_t>& b) {
+      for (size_t i = b.begin(); i < b.end(); ++i) {
+        uint32_t bk = point_bucket_[i];
+        if (bk == kNone) continue;
+        uint32_t slot = start_[bk].fetch_add(1, std::memory_order_relaxed);
+        entries_[slot] = Entry{p[i].x, p[i].y, p[i].z, r[i]};
+        index_[slot] = static_cast<uint32_t>(i);
       }
     });
   }
@@ -98,36 +114,68 @@ class VisiblePointGrid {
   /// meanwhile; any number of threads may query at once (the build has finished, so relaxed loads do).
   template <class F>
   void for_each_within(const Vec3& q, F&& f) const {
-    if (!active_) return;
-    glm::ivec3 c;
-    for (int k = 0; k < 3; ++k) {
-      double x = (q[k] - origin_[k]) * inv_cell_;
-      if (!(x >= 0.0) || x >= res_[k]) return;  // outside every point's disk
-      c[k] = std::min(static_cast<int>(x), res_[k] - 1);
-    }
-    for (uint32_t n = heads_[bucket(c)].load(std::memory_order_relaxed); n != kEnd; n = nodes_[n].next) {
-      uint32_t i = nodes_[n].point;
-      Vec3 d = p_[i] - q;
-      if (glm::dot(d, d) <= r_[i] * r_[i]) f(i);
-    }
+    for_each_entry_within(q, [&](uint32_t slot) { f(index_[slot]); });
   }
 
+  /// As for_each_within, but calls f(slot) with the point's slot in the grid's order (point_of(slot)
+  /// is its index): data kept per slot lies together for points of one cell, which a photon's
+  /// neighbours share.
+  template <class F>
+  void for_each_entry_within(const Vec3& q, F&& f) const {
+    if (!active_) return;
+    glm::ivec3 lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      double a = (static_cast<double>(q[k]) - reach_ - origin_[k]) * inv_cell_;
+      double b = (static_cast<double>(q[k]) + reach_ - origin_[k]) * inv_cell_;
+      if (!(b >= 0.0) || !(a < res_[k])) return;  // outside every point's disk (or q is not finite)
+      lo[k] = a <= 0.0 ? 0 : static_cast<int>(a);
+      hi[k] = std::min(static_cast<int>(b), res_[k] - 1);
+    }
+    // Three steps, so that the cache misses of the (up to 8) cells overlap instead of following
+    // one another: the distinct buckets (prefetching their bounds), their ranges (prefetching the
+    // first entries), then the scan.
+    uint32_t bks[27];
+    int n = 0;
+    for (int z = lo.z; z <= hi.z; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) {
+          uint32_t bk = bucket({x, y, z});
+          if (std::find(bks, bks + n, bk) != bks + n) continue;
+          bks[n++] = bk;
+          __builtin_prefetch(&start_[bk == 0 ? 0 : bk - 1]);
+        }
+    uint32_t begin[27], end[27];
+    for (int j = 0; j < n; ++j) {
+      begin[j] = bks[j] == 0 ? 0 : start_[bks[j] - 1].load(std::memory_order_relaxed);
+      end[j] = start_[bks[j]].load(std::memory_order_relaxed);
+      if (begin[j] < end[j]) __builtin_prefetch(&entries_[begin[j]]);
+    }
+    for (int j = 0; j < n; ++j)
+      for (uint32_t s = begin[j]; s < end[j]; ++s) {
+        const Entry& en = entries_[s];
+        Vec3 d = Vec3(en.x, en.y, en.z) - q;
+        if (glm::dot(d, d) <= en.r * en.r) f(s);
+      }
+  }
+
+  /// The point held in a slot (slots run from 0 to node_count() - 1).
+  uint32_t point_of(uint32_t slot) const { return index_[slot]; }
+
+  /// Entries held by the grid (one per point with a positive radius).
   size_t node_count() const { return node_count_; }
   size_t bucket_count() const { return active_ ? bucket_mask_ + 1 : 0; }
   double cell_size() const { return cell_; }
   glm::ivec3 resolution() const { return res_; }
   /// Bytes held (kept between builds).
   size_t memory_bytes() const {
-    return bucket_capacity_ * sizeof(uint32_t) + nodes_.capacity() * sizeof(Node) +
-           first_node_.capacity() * sizeof(uint32_t);
+    return start_.capacity() * sizeof(uint32_t) + entries_.capacity() * sizeof(Entry) +
+           index_.capacity() * sizeof(uint32_t) + point_bucket_.capacity() * sizeof(uint32_t);
   }
 
  private:
-  static constexpr uint32_t kEnd = 0xffffffffu;
-  static constexpr int kMaxCellsPerPoint = 27;
-  struct Node {
-    uint32_t point;
-    uint32_t next;
+  static constexpr uint32_t kNone = 0xffffffffu;
+  struct Entry {
+    float x, y, z, r;
   };
   struct Extent {
     Vec3 lo{Infinity}, hi{-Infinity};
@@ -169,34 +217,15 @@ class VisiblePointGrid {
     return static_cast<uint32_t>(mix_bits(key) & bucket_mask_);
   }
 
-  /// The distinct buckets of the cells point i's disk overlaps (its bounding box, clamped to the grid).
-  uint32_t point_buckets(size_t i, uint32_t out[kMaxCellsPerPoint]) const {
-    if (!active_point(p_[i], r_[i])) return 0;
-    glm::ivec3 lo, hi;
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = cell_coordinate(static_cast<double>(p_[i][k]) - r_[i], k);
-      hi[k] = cell_coordinate(static_cast<double>(p_[i][k]) + r_[i], k);
-    }
-    uint32_t n = 0;
-    for (int z = lo.z; z <= hi.z; ++z)
-      for (int y = lo.y; y <= hi.y; ++y)
-        for (int x = lo.x; x <= hi.x; ++x) {
-          uint32_t b = bucket({x, y, z});
-          if (std::find(out, out + n, b) == out + n) out[n++] = b;
-        }
-    return n;
-  }
-
-  std::span<const Vec3> p_;
-  std::span<const float> r_;
   bool active_ = false;
   glm::dvec3 origin_{0.0};
-  double cell_ = 1.0, inv_cell_ = 1.0;
+  double cell_ = 1.0, inv_cell_ = 1.0, reach_ = 0.0;
   glm::ivec3 res_{1};
-  std::unique_ptr<std::atomic<uint32_t>[]> heads_;
-  size_t bucket_capacity_ = 0, bucket_mask_ = 0;
-  std::vector<Node> nodes_;
-  std::vector<uint32_t> first_node_;
+  std::vector<std::atomic<uint32_t>> start_;  // during the build: counts, then cursors; see build()
+  size_t bucket_mask_ = 0;
+  std::vector<Entry> entries_;
+  std::vector<uint32_t> index_;
+  std::vector<uint32_t> point_bucket_;
   size_t node_count_ = 0;
 };
 
