@@ -1,5 +1,5 @@
 // Hierarchical Russian roulette (HRR) for connecting an eye vertex z to a large cache of light
-// vertices {y_i} (Tokuyoshi & Harada, TOG 38(4), 2019; ALGORITHMS.md section 1).
+// vertices {y_i} (Tokuyoshi & Harada, TOG 38(4), 2019; docs/algorithms.md and docs/hrr.md).
 //
 // Every pair (y_i, z) is kept with probability P(y_i, z) = min(C q(w) / d^2, 1), where q is an
 // approximation of z's scattering lobe. Rather than drawing one uniform per pair, the numbers are
@@ -44,12 +44,12 @@
 //    pseudo-code hands the new minimum to both children; that loses the real minimum, and the
 //    marginal-uniformity test catches it.) b climbs toward 1 with depth, so b and 1 - b are both
 //    kept in double: b is added to (accurate while b is small) and 1 - b is multiplied by
-//    (1 - 1/|L_m|) (accurate while b is near 1; ALGORITHMS.md 1.7). A float b does stall, but only
+//    (1 - 1/|L_m|) (accurate while b is near 1; docs/algorithms.md, "The bound b"). A float b does stall, but only
 //    in very deep trees: along any path b <= (depth + 1)/|L|, so the step (1 - b)/|L_m| is at least
 //    ~b/depth (~1/depth^2 once b nears 1); the tests build a chain of depth 2^26 to show the stall.
 //    In float, 1 - b does stall in ordinary trees (1 - 2^-40 rounds to 1), which the tests also
 //    show. xi/|L| keeps full relative precision for any |L| (one division, no 1 - (1 - xi)^(1/N)
-//    cancellation; ALGORITHMS.md 8.5).
+//    cancellation; docs/algorithms.md, "The minimum of N uniforms").
 //
 //  * HrrRandom: counter-based numbers hash(seed, node, slot), so a culled traversal and an unculled
 //    one see the same number at the same node. That is what makes "culling changes nothing but the
@@ -122,8 +122,8 @@ struct SelLobe {
 /// The lobe of an eye vertex at world position z with shading frame `shading` from a BSDF's
 /// LobeSummary (peak in the local shading frame). A GGX lobe becomes K(w; Q_peak, alpha_x, alpha_y):
 /// the reflected-direction lobe of a GGX with roughness alpha is ~ K with the SAME alpha around the
-/// mirror direction, since theta_half ~ theta_refl / 2 and pi alpha^2 D ~ K(alpha / 2) (ALGORITHMS.md
-/// 1.4 [derived]; checked against the real BSDF in the tests). Its tangent axes are the shading s/t
+/// mirror direction, since theta_half ~ theta_refl / 2 and pi alpha^2 D ~ K(alpha / 2) (derived in
+/// docs/hrr.md, "HRR at one eye vertex"; checked against the real BSDF in the tests). Its tangent axes are the shading s/t
 /// axes projected perpendicular to the peak. A cosine lobe becomes the sphere (alpha 1), a valid
 /// bound for rho/pi cos. c (the BSDF * cos at the peak) and the half space come from the caller.
 SelLobe make_sel_lobe(const Vec3& z, const Frame& shading, const LobeSummary& lobe, double c,

@@ -1,4 +1,4 @@
-// Probabilistic connections (Popov, Ramamoorthi, Durand, Drettakis, EGSR 2015; ALGORITHMS.md §2):
+// Probabilistic connections (Popov, Ramamoorthi, Durand, Drettakis, EGSR 2015; docs/algorithms.md, docs/hrr.md):
 // a cache that lets an eye vertex importance-sample WHICH stored light vertex to connect to.
 //
 // The module only knows what it is handed: cache-point positions and normals, a vertex count and a
