@@ -15,9 +15,6 @@ bench_scene_names() { awk 'NF == 3 { print $1 }' <<<"$BENCH_SCENE_TABLE"; }
 bench_scene_file() { awk -v n="$1" '$1 == n { print $2 }' <<<"$BENCH_SCENE_TABLE"; }
 bench_scene_reference_integrator() { awk -v n="$1" '$1 == n { print $3 }' <<<"$BENCH_SCENE_TABLE"; }
 
-# Parameters every render of a benchmark scene gets with this integrator (besides the scene's own).
-# SPPM's gather radius is passed here rather than in the scene files: 0.01 world units (the scenes
-# are 2 to 2.6 units across); its default is being changed elsewhere.
 # Extra render options per integrator: none, every integrator runs with its defaults (sppm's initial
 # radius comes from the pixel footprint).
 bench_integrator_params() {
