@@ -5,10 +5,27 @@
 
 namespace penumbra {
 
+namespace {
+std::atomic<uint64_t> next_id{1};
+}
+
 SplatBuffers::SplatBuffers(Point2i resolution)
     : resolution_(resolution),
       blocks_x_((resolution.x + kBlock - 1) / kBlock),
-      blocks_y_((resolution.y + kBlock - 1) / kBlock) {}
+      blocks_y_((resolution.y + kBlock - 1) / kBlock),
+      id_(next_id.fetch_add(1)) {}
+
+// The calling thread's buffer: TBB's lookup by thread id once, then a thread-local cache (a splat
+// costs a comparison instead of a hash lookup).
+SplatBuffers::ThreadBuffer& SplatBuffers::local() {
+  thread_local uint64_t cached_id = 0;
+  thread_local ThreadBuffer* cached = nullptr;
+  if (cached_id != id_) {
+    cached = &threads_.local();
+    cached_id = id_;
+  }
+  return *cached;
+}
 
 bool SplatBuffers::add(int x, int y, const Rgb& v) {
   Fixed q[3];
@@ -17,7 +34,7 @@ bool SplatBuffers::add(int x, int y, const Rgb& v) {
     if (!(std::abs(s) < 0x1p120)) return false;
     q[c] = static_cast<Fixed>(std::nearbyint(s));
   }
-  ThreadBuffer& tb = threads_.local();
+  ThreadBuffer& tb = local();
   if (tb.blocks.empty()) tb.blocks.resize(static_cast<size_t>(blocks_x_) * blocks_y_);
   std::unique_ptr<Block>& b = tb.blocks[static_cast<size_t>(y / kBlock) * blocks_x_ + x / kBlock];
   if (!b) {

@@ -36,8 +36,10 @@ class SplatBuffers {
   struct ThreadBuffer {
     std::vector<std::unique_ptr<Block>> blocks;
   };
+  ThreadBuffer& local();
   Point2i resolution_;
   int blocks_x_, blocks_y_;
+  uint64_t id_;  // unique per instance, so a thread's cached buffer is never another film's
   mutable tbb::enumerable_thread_specific<ThreadBuffer> threads_;
   std::atomic<bool> any_{false};
 };
