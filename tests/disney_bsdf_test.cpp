@@ -266,20 +266,14 @@ namespace {
 double burley_albedo_by_quadrature(double roughness, const Vec3& wo_f) {
   glm::dvec3 wo(wo_f.x, wo_f.y, std::abs(wo_f.z));  // two-sided: the lower side mirrors the upper
   auto F = [](double c) { return std::pow(1.0 - c, 5.0); };
-  const int nt = 400, np = 200;
-  double sum = 0.0;
-  for (int i = 0; i < nt; ++i) {
-    double ci = (i + 0.5) / nt, si = std::sqrt(1.0 - ci * ci);
-    for (int j = 0; j < np; ++j) {
-      double phi = 2.0 * M_PI * (j + 0.5) / np;
-      glm::dvec3 wi(si * std::cos(phi), si * std::sin(phi), ci);
-      double cos_d = glm::dot(wi, glm::normalize(wi + wo));
-      double fo = F(wo.z), fi = F(ci), rr = 2.0 * roughness * cos_d * cos_d;
-      double f = (1.0 - 0.5 * fo) * (1.0 - 0.5 * fi) + rr * (fo + fi + fo * fi * (rr - 1.0));
-      sum += f / M_PI * ci;
-    }
-  }
-  return sum * (1.0 / nt) * (2.0 * M_PI / np);
+  return test::hemisphere_quadrature(
+      [&](const glm::dvec3& wi) {
+        double cos_d = glm::dot(wi, glm::normalize(wi + wo));
+        double fo = F(wo.z), fi = F(wi.z), rr = 2.0 * roughness * cos_d * cos_d;
+        double f = (1.0 - 0.5 * fo) * (1.0 - 0.5 * fi) + rr * (fo + fi + fo * fi * (rr - 1.0));
+        return f / M_PI * wi.z;
+      },
+      400, 200);
 }
 
 }  // namespace

@@ -234,6 +234,18 @@ PdfConsistency pdf_consistency(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t
   return r;
 }
 
+double hemisphere_quadrature(const std::function<double(const glm::dvec3& wi)>& f_cos, int nt, int np) {
+  double sum = 0.0;
+  for (int i = 0; i < nt; ++i) {
+    double ci = (i + 0.5) / nt, si = std::sqrt(1.0 - ci * ci);
+    for (int j = 0; j < np; ++j) {
+      double phi = 2.0 * M_PI * (j + 0.5) / np;
+      sum += f_cos(glm::dvec3(si * std::cos(phi), si * std::sin(phi), ci));
+    }
+  }
+  return sum * (1.0 / nt) * (2.0 * M_PI / np);
+}
+
 double ggx_albedo_by_quadrature(double alpha, double cos_o) {
   auto lambda = [alpha](double c) {
     double t2 = (1.0 - c * c) / (c * c);
@@ -245,19 +257,13 @@ double ggx_albedo_by_quadrature(double alpha, double cos_o) {
     return a2 / (M_PI * e * e);
   };
   glm::dvec3 wo(std::sqrt(1.0 - cos_o * cos_o), 0.0, cos_o);
-  const int nt = 1500, np = 600;
-  double sum = 0.0;
-  for (int i = 0; i < nt; ++i) {
-    double ci = (i + 0.5) / nt, si = std::sqrt(1.0 - ci * ci);
-    for (int j = 0; j < np; ++j) {
-      double phi = 2.0 * M_PI * (j + 0.5) / np;
-      glm::dvec3 wi(si * std::cos(phi), si * std::sin(phi), ci);
-      glm::dvec3 wm = glm::normalize(wi + wo);
-      double g2 = 1.0 / (1.0 + lambda(cos_o) + lambda(ci));
-      sum += D(wm.z) * g2 / (4.0 * cos_o);  // f cos_i = D G2 / (4 cos_o cos_i) * cos_i
-    }
-  }
-  return sum * (1.0 / nt) * (2.0 * M_PI / np);
+  // f cos_i = D G2 / (4 cos_o cos_i) * cos_i
+  return hemisphere_quadrature(
+      [&](const glm::dvec3& wi) {
+        glm::dvec3 wm = glm::normalize(wi + wo);
+        return D(wm.z) / (1.0 + lambda(cos_o) + lambda(wi.z)) / (4.0 * cos_o);
+      },
+      1500, 600);
 }
 
 }  // namespace penumbra::test

@@ -7,6 +7,8 @@
 //   EXPECT_TRUE(r.passes(sidak_alpha(0.01, number_of_tests))) << r.summary();
 #pragma once
 
+#include <functional>
+
 #include "support/chi_square.h"
 
 #include <penumbra/bsdf.h>
@@ -50,6 +52,10 @@ struct AlbedoEstimate {
   double max_weight = 0.0;   // largest f |cos| / pdf seen (fireflies)
   int non_finite = 0;        // samples with NaN or infinite weights (a bug)
 };
+
+/// Integral of `f_cos(wi)` over the upper hemisphere by midpoint quadrature in (cos theta, phi) on an
+/// nt x np grid (dwi = dcos dphi): the independent side of a furnace test.
+double hemisphere_quadrature(const std::function<double(const glm::dvec3& wi)>& f_cos, int nt, int np);
 
 /// The single-scattering albedo of an isotropic GGX (Trowbridge-Reitz) surface with Fresnel 1 seen
 /// from a direction with cosine `cos_o`: int D(wm) G2(wo, wi) / (4 cos_o) dwi by midpoint quadrature
