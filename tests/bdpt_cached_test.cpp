@@ -280,29 +280,6 @@ double region_mean(const ImageRgb& img, int y0) {
   return sum / (3.0 * img.width * (img.height - y0));
 }
 
-// Worst relative difference of the 4x4 block means below row y0 (blocks darker than floor compare
-// against floor).
-double worst_block(const ImageRgb& a, const ImageRgb& b, int y0, double floor) {
-  double worst = 0.0;
-  for (int by = 0; by < 4; ++by)
-    for (int bx = 0; bx < 4; ++bx) {
-      double sa = 0, sb = 0;
-      int n = 0;
-      for (int y = std::max(y0, by * 8); y < (by + 1) * 8; ++y)
-        for (int x = bx * 8; x < (bx + 1) * 8; ++x, ++n)
-          for (int c = 0; c < 3; ++c) {
-            size_t i = 3 * (static_cast<size_t>(y) * a.width + x) + c;
-            sa += a.pixels[i];
-            sb += b.pixels[i];
-          }
-      if (n == 0) continue;
-      sa /= 3.0 * n;
-      sb /= 3.0 * n;
-      worst = std::max(worst, std::abs(sa - sb) / std::max(floor, sb));
-    }
-  return worst;
-}
-
 }  // namespace
 
 namespace {
