@@ -28,7 +28,9 @@ def main():
     print("discussion of each scene lives in `docs/convergence-notes/`.\n")
     print("relMSE = mean over pixels and channels of (I - R)^2 / (R^2 + 0.01), with the reference's own")
     print("variance (estimated from two independent half-length references) subtracted. Each point is the")
-    print("mean over independent runs (different seeds); the band in the plots spans their min and max.")
+    print("median over independent runs (different seeds); the band in the plots is their interquartile")
+    print("range. Each study's `report.html` (beside its summary.json) has the bootstrap intervals of every")
+    print("ratio at equal time; a ranking is a conclusion only where its interval excludes 1.")
     print("Efficiency = 1 / (relMSE x T) at the last snapshot: higher is better, and constant in T for an")
     print("unbiased method whose relMSE falls as 1/T (slope -1).\n")
     for name in sorted(os.listdir(root)):
