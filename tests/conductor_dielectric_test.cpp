@@ -420,18 +420,11 @@ TEST(Conductor, RoughFurnaceMatchesIndependentAlbedo) {
 
 // The single-scattering albedo of a rough dielectric (reflection plus transmission, importance
 // transport: no 1/eta'^2), written here from the formulas (Walter et al. 2007: generalized half
-// vector, Fresnel for unpolarised light, Trowbridge-Reitz D, height-correlated Smith G2) without the
-// SDK's microfacet code, by quadrature over both hemispheres.
+// vector, Fresnel for unpolarised light, Trowbridge-Reitz D and height-correlated Smith G2 from
+// tests/support) without the SDK's microfacet code, by quadrature over both hemispheres.
 double rough_dielectric_albedo(double alpha, double eta, double cos_o) {
-  auto lambda = [alpha](double c) {
-    double t2 = (1.0 - c * c) / (c * c);
-    return 0.5 * (std::sqrt(1.0 + alpha * alpha * t2) - 1.0);
-  };
-  auto D = [alpha](double c) {
-    double c2 = c * c, a2 = alpha * alpha;
-    double e = c2 * (a2 - 1.0) + 1.0;
-    return a2 / (M_PI * e * e);
-  };
+  auto lambda = [alpha](double c) { return test::ggx_lambda(alpha, c); };
+  auto D = [alpha](double c) { return test::ggx_d(alpha, c); };
   auto fresnel = [eta](double ci) {  // ci > 0: from outside into the medium of index eta
     double s2 = (1.0 - ci * ci) / (eta * eta);
     if (s2 >= 1.0) return 1.0;

@@ -246,22 +246,23 @@ double hemisphere_quadrature(const std::function<double(const glm::dvec3& wi)>& 
   return sum * (1.0 / nt) * (2.0 * M_PI / np);
 }
 
+double ggx_d(double alpha, double cos_m) {
+  double a2 = alpha * alpha, e = cos_m * cos_m * (a2 - 1.0) + 1.0;
+  return a2 / (M_PI * e * e);
+}
+
+double ggx_lambda(double alpha, double cos_w) {
+  double t2 = (1.0 - cos_w * cos_w) / (cos_w * cos_w);
+  return 0.5 * (std::sqrt(1.0 + alpha * alpha * t2) - 1.0);
+}
+
 double ggx_albedo_by_quadrature(double alpha, double cos_o) {
-  auto lambda = [alpha](double c) {
-    double t2 = (1.0 - c * c) / (c * c);
-    return 0.5 * (std::sqrt(1.0 + alpha * alpha * t2) - 1.0);
-  };
-  auto D = [alpha](double c) {
-    double c2 = c * c, a2 = alpha * alpha;
-    double e = c2 * (a2 - 1.0) + 1.0;
-    return a2 / (M_PI * e * e);
-  };
   glm::dvec3 wo(std::sqrt(1.0 - cos_o * cos_o), 0.0, cos_o);
   // f cos_i = D G2 / (4 cos_o cos_i) * cos_i
   return hemisphere_quadrature(
       [&](const glm::dvec3& wi) {
         glm::dvec3 wm = glm::normalize(wi + wo);
-        return D(wm.z) / (1.0 + lambda(cos_o) + lambda(wi.z)) / (4.0 * cos_o);
+        return ggx_d(alpha, wm.z) / (1.0 + ggx_lambda(alpha, cos_o) + ggx_lambda(alpha, wi.z)) / (4.0 * cos_o);
       },
       1500, 600);
 }

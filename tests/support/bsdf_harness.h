@@ -57,6 +57,12 @@ struct AlbedoEstimate {
 /// nt x np grid (dwi = dcos dphi): the independent side of a furnace test.
 double hemisphere_quadrature(const std::function<double(const glm::dvec3& wi)>& f_cos, int nt, int np);
 
+/// Isotropic Trowbridge-Reitz (GGX) normal distribution at a microfacet normal with cosine `cos_m`,
+/// and Smith's Lambda for a direction with cosine `cos_w`, written from the formulas (not the SDK's
+/// microfacet code) for the independent side of furnace tests.
+double ggx_d(double alpha, double cos_m);
+double ggx_lambda(double alpha, double cos_w);
+
 /// The single-scattering albedo of an isotropic GGX (Trowbridge-Reitz) surface with Fresnel 1 seen
 /// from a direction with cosine `cos_o`: int D(wm) G2(wo, wi) / (4 cos_o) dwi by midpoint quadrature
 /// in (cos theta_i, phi_i), written from the formulas without the SDK's microfacet code, so a furnace
