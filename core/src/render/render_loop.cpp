@@ -58,15 +58,25 @@ void SampleIntegrator::render(RenderContext& ctx) {
   const uint64_t pixels = static_cast<uint64_t>(res.x) * res.y;
   const uint64_t total = pixels * static_cast<uint64_t>(opt.spp);
   const bool surface_aovs = film.wants_surface_samples();
+  begin_render(ctx);
+  // Asked after begin_render(), since they may depend on what it set up.
   const bool to_film = film_holds_estimate();
+  const int max_pass = std::max(1, max_pass_samples());
 
   tbb::enumerable_thread_specific<ThreadState> threads(
       [&] { return ThreadState{ctx.sampler().clone(), CheckedSplats(ctx, film)}; });
 
-  begin_render(ctx);
-  const int max_pass = std::max(1, max_pass_samples());  // may depend on what begin_render set up
+  // What the runtime learns after each pass: whole passes done, what the splats are divided by (the
+  // pixel samples actually taken over the pixel count) and, when the film does not hold it, where
+  // the estimate comes from.
   std::atomic<uint64_t> samples_taken{0};  // over all passes, cut ones included
-  int done_spp = 0, pass_spp = 1;
+  int done_spp = 0;
+  const std::function<ImageRgb()> estimate_fn = to_film ? std::function<ImageRgb()>() : [this] { return estimate(); };
+  auto report = [&] {
+    ctx.set_completed_spp(done_spp, estimate_fn, static_cast<double>(samples_taken.load()) / static_cast<double>(pixels));
+  };
+
+  int pass_spp = 1;
   while (done_spp < opt.spp && !ctx.should_stop()) {
     Pass pass;
     pass.first_index = static_cast<uint32_t>(opt.first_sample + done_spp);
@@ -118,11 +128,7 @@ void SampleIntegrator::render(RenderContext& ctx) {
     end_pass(ctx, pass);
     if (!pass.complete) break;
     done_spp += pass.count;
-    double splat_spp = static_cast<double>(samples_taken.load()) / static_cast<double>(pixels);
-    if (to_film)
-      ctx.set_completed_spp(done_spp, {}, splat_spp);
-    else
-      ctx.set_completed_spp(done_spp, [this] { return estimate(); }, splat_spp);
+    report();
     if (ctx.should_stop()) break;
     // Short passes first so a time budget is met closely, longer ones later for less overhead;
     // with a budget, a pass never takes much more than the time that is left.
@@ -135,8 +141,7 @@ void SampleIntegrator::render(RenderContext& ctx) {
   }
   // A pass cut short still adds its samples: pixel means stay unbiased, and the splats are divided
   // by the samples actually taken.
-  double splat_spp = static_cast<double>(samples_taken.load()) / static_cast<double>(pixels);
-  if (splat_spp > done_spp) ctx.set_completed_spp(done_spp, to_film ? std::function<ImageRgb()>() : [this] { return estimate(); }, splat_spp);
+  if (samples_taken.load() > static_cast<uint64_t>(done_spp) * pixels) report();
   end_render(ctx, done_spp);
 }
 
