@@ -116,8 +116,8 @@ class SampleIntegrator : public Integrator {
   /// Largest number of samples per pixel in one pass (1 when begin_pass prepares per-sample state);
   /// asked after begin_render().
   virtual int max_pass_samples() const { return 16; }
-  /// False when the film does not hold the estimate (photon mapping; asked after begin_render()): the loop then adds no pixel
-  /// samples to the film (only AOVs), snapshots ask estimate(), and end_render() fills the film.
+  /// False when the film does not hold the estimate (photon mapping; asked after begin_render()):
+  /// the loop then adds no pixel samples to the film (only AOVs), snapshots ask estimate(), and end_render() fills the film.
   virtual bool film_holds_estimate() const { return true; }
   /// The current estimate, when the film does not hold it.
   virtual ImageRgb estimate() const { return {}; }
