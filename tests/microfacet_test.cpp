@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <complex>
+
 #include <vector>
 
 namespace penumbra {
@@ -163,18 +165,49 @@ TEST(Fresnel, DielectricValues) {
 TEST(Fresnel, ComplexReducesToDielectricWithoutAbsorption) {
   for (float eta : {1.1f, 1.5f, 2.5f})
     for (float c : {0.f, 0.05f, 0.3f, 0.7f, 1.f})
-      EXPECT_NEAR(fresnel_complex(c, std::complex<float>(eta, 0.f)), fresnel_dielectric(c, eta), 1e-5f)
+      EXPECT_NEAR(fresnel_conductor(c, eta, 0.f), fresnel_dielectric(c, eta), 1e-5f)
           << "eta " << eta << " cos " << c;
   // pbrt-v4's reflectance parameterisation: eta = 1, k = 2 sqrt(R)/sqrt(1 - R) gives F(0 deg) = R.
   for (float R : {0.1f, 0.5f, 0.9f}) {
     float k = 2.f * std::sqrt(R) / std::sqrt(1.f - R);
-    EXPECT_NEAR(fresnel_complex(1.f, std::complex<float>(1.f, k)), R, 1e-5f);
+    EXPECT_NEAR(fresnel_conductor(1.f, 1.f, k), R, 1e-5f);
   }
   Rgb copper = fresnel_complex(1.f, Rgb(0.200438f, 0.924033f, 1.102212f), Rgb(3.912949f, 2.452848f, 2.142188f));
   EXPECT_GT(copper.r, copper.g);
   EXPECT_GT(copper.g, copper.b);
   EXPECT_TRUE(copper.r < 1.f && copper.b > 0.4f);
-  EXPECT_NEAR(fresnel_complex(0.f, std::complex<float>(1.f, 0.f)), 1.f, 1e-6f);  // no NaN at 0/0
+  EXPECT_NEAR(fresnel_conductor(0.f, 1.f, 0.f), 1.f, 1e-6f);  // no NaN at 0/0
+}
+
+// The textbook form with complex amplitudes r_s, r_p (in double), independent of the closed form.
+static double fresnel_by_complex_amplitudes(double cos_i, std::complex<double> eta) {
+  using C = std::complex<double>;
+  C sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+  C cos_t = std::sqrt(C(1.0) - sin2_t);
+  C r_s = (C(cos_i) - eta * cos_t) / (C(cos_i) + eta * cos_t);
+  C r_p = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  return 0.5 * (std::norm(r_s) + std::norm(r_p));
+}
+
+TEST(Fresnel, ConductorClosedFormMatchesComplexAmplitudes) {
+  // Gold, silver-like, aluminium-like, a weak absorber and pbrt-v4's reflectance 0.9999 (k = 200).
+  const std::pair<float, float> iors[] = {{0.143f, 3.98f}, {0.155f, 4.83f}, {1.66f, 9.22f}, {1.5f, 0.1f},
+                                          {1.f, 199.99f}};
+  double worst = 0.0;
+  for (auto [eta, k] : iors)
+    for (int i = 0; i <= 100; ++i) {
+      float c = static_cast<float>(i) / 100.f;
+      double want = fresnel_by_complex_amplitudes(c, {eta, k});
+      double got = fresnel_conductor(c, eta, k);
+      worst = std::max(worst, std::abs(got - want));
+      ASSERT_NEAR(got, want, 2e-6) << "eta " << eta << " k " << k << " cos " << c;
+    }
+  // Negative control: a 1 % change of k moves some value by far more than the tolerance.
+  double moved = 0.0;
+  for (int i = 0; i <= 100; ++i)
+    moved = std::max(moved, std::abs(fresnel_conductor(i / 100.f, 0.143f, 3.98f * 1.01f) -
+                                      fresnel_by_complex_amplitudes(i / 100.0, {0.143, 3.98})));
+  EXPECT_GT(moved, 100 * 2e-6) << "worst agreement " << worst;
 }
 
 TEST(Refraction, SnellsLawAndReversibility) {

@@ -15,6 +15,7 @@
 #include <penumbra/math.h>
 #include <penumbra/params.h>
 
+#include <algorithm>
 #include <complex>
 
 namespace penumbra {
@@ -145,24 +146,33 @@ inline float fresnel_dielectric(float cos_theta_i, float eta) {
 
 /// Fresnel reflectance of a conductor with complex IOR eta + i k (relative to the outside medium),
 /// for one wavelength. cos_theta_i is clamped to [0, 1]: light reaches a conductor from outside only.
-inline float fresnel_complex(float cos_theta_i, std::complex<float> eta) {
-  using C = std::complex<float>;
-  cos_theta_i = std::clamp(cos_theta_i, 0.f, 1.f);
-  C sin2_t = (1.f - sqr(cos_theta_i)) / (eta * eta);
-  C cos_t = std::sqrt(C(1.f) - sin2_t);
-  C d_parallel = eta * cos_theta_i + cos_t, d_perpendicular = C(cos_theta_i) + eta * cos_t;
+/// Real arithmetic in double (the closed form of |r_s|^2 and |r_p|^2 through a^2 + b^2 = |eta^2 -
+/// sin^2|): the same values as the complex-number formula, without its library calls.
+inline float fresnel_conductor(float cos_theta_i, float eta, float k) {
+  double c = std::clamp(static_cast<double>(cos_theta_i), 0.0, 1.0);
+  double c2 = c * c, s2 = 1.0 - c2;
+  double e2 = static_cast<double>(eta) * eta, k2 = static_cast<double>(k) * k;
+  double t0 = e2 - k2 - s2;
+  double a2b2 = std::sqrt(t0 * t0 + 4.0 * e2 * k2);
+  double a = std::sqrt(std::max(0.0, 0.5 * (a2b2 + t0)));
+  double t1 = a2b2 + c2, t2 = 2.0 * a * c;
   // Only a lossless interface with eta = 1 viewed at exactly grazing gets here: the limit is 1.
-  if (std::norm(d_parallel) == 0.f || std::norm(d_perpendicular) == 0.f) return 1.f;
-  C r_parallel = (eta * cos_theta_i - cos_t) / d_parallel;
-  C r_perpendicular = (C(cos_theta_i) - eta * cos_t) / d_perpendicular;
-  return 0.5f * (std::norm(r_parallel) + std::norm(r_perpendicular));
+  if (t1 + t2 == 0.0) return 1.f;
+  double rs = (t1 - t2) / (t1 + t2);
+  double t3 = c2 * a2b2 + s2 * s2, t4 = t2 * s2;
+  double rp = rs * (t3 - t4) / (t3 + t4);
+  return static_cast<float>(0.5 * (rs + rp));
+}
+
+/// The same with the complex IOR as one number (kept for plugins written against SDK 4.0).
+inline float fresnel_complex(float cos_theta_i, std::complex<float> eta) {
+  return fresnel_conductor(cos_theta_i, eta.real(), eta.imag());
 }
 
 /// Conductor Fresnel reflectance per RGB channel (eta and k per channel).
 inline Rgb fresnel_complex(float cos_theta_i, const Rgb& eta, const Rgb& k) {
-  return Rgb(fresnel_complex(cos_theta_i, std::complex<float>(eta.r, k.r)),
-             fresnel_complex(cos_theta_i, std::complex<float>(eta.g, k.g)),
-             fresnel_complex(cos_theta_i, std::complex<float>(eta.b, k.b)));
+  return Rgb(fresnel_conductor(cos_theta_i, eta.r, k.r), fresnel_conductor(cos_theta_i, eta.g, k.g),
+             fresnel_conductor(cos_theta_i, eta.b, k.b));
 }
 
 /// Mirror reflection of wo about n (both pointing away from the surface).

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace penumbra {
 
@@ -27,12 +31,24 @@ SplatBuffers::ThreadBuffer& SplatBuffers::local() {
   return *cached;
 }
 
+namespace {
+// Round to nearest (ties to even, the default rounding mode) for |x| < 2^62: on x86-64 one
+// instruction, where std::nearbyint and the conversion to 128 bits are two library calls.
+inline int64_t round_to_int64(double x) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_si64(_mm_set_sd(x));
+#else
+  return static_cast<int64_t>(std::nearbyint(x));
+#endif
+}
+}  // namespace
+
 bool SplatBuffers::add(int x, int y, const Rgb& v) {
   Fixed q[3];
   for (int c = 0; c < 3; ++c) {
     double s = static_cast<double>(v[c]) * kScale;
     if (!(std::abs(s) < 0x1p120)) return false;
-    q[c] = static_cast<Fixed>(std::nearbyint(s));
+    q[c] = std::abs(s) < 0x1p62 ? static_cast<Fixed>(round_to_int64(s)) : static_cast<Fixed>(std::nearbyint(s));
   }
   ThreadBuffer& tb = local();
   if (tb.blocks.empty()) tb.blocks.resize(static_cast<size_t>(blocks_x_) * blocks_y_);

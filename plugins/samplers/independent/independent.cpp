@@ -19,11 +19,26 @@ class IndependentSampler final : public Sampler {
  public:
   IndependentSampler(int spp, int seed) : spp_(spp), seed_(seed) {}
   int samples_per_pixel() const override { return spp_; }
+  // Integrators that seek to a dimension several times per sample (bdpt's subpaths) reuse the
+  // pixel's stream and the sample's start: only the jump by `dimension` is repeated, and a seek
+  // gives exactly the values of a fresh start.
   void start_pixel_sample(Point2i pixel, uint32_t index, uint32_t dimension) override {
-    rng_.set_sequence(hash_ints(static_cast<uint32_t>(pixel.x), static_cast<uint32_t>(pixel.y),
-                                static_cast<uint64_t>(static_cast<uint32_t>(seed_))),
-                      0);
-    rng_.advance(static_cast<uint64_t>(index) * 65536ull + dimension);
+    if (!have_pixel_ || pixel != pixel_) {
+      pixel_start_.set_sequence(hash_ints(static_cast<uint32_t>(pixel.x), static_cast<uint32_t>(pixel.y),
+                                          static_cast<uint64_t>(static_cast<uint32_t>(seed_))),
+                                0);
+      pixel_ = pixel;
+      have_pixel_ = true;
+      have_index_ = false;
+    }
+    if (!have_index_ || index != index_) {
+      sample_start_ = pixel_start_;
+      sample_start_.advance(static_cast<uint64_t>(index) * 65536ull);
+      index_ = index;
+      have_index_ = true;
+    }
+    rng_ = sample_start_;
+    if (dimension) rng_.advance(dimension);
   }
   float get_1d() override { return rng_.next_float(); }
   Vec2 get_2d() override {
@@ -35,7 +50,10 @@ class IndependentSampler final : public Sampler {
 
  private:
   int spp_, seed_;
-  Pcg32 rng_;
+  Pcg32 rng_, pixel_start_, sample_start_;
+  Point2i pixel_{0, 0};
+  uint32_t index_ = 0;
+  bool have_pixel_ = false, have_index_ = false;
 };
 
 const ParamSpec kParams[] = {
