@@ -5,6 +5,7 @@
 
 #include <fmt/core.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 
@@ -27,6 +28,14 @@ int run_render(const RenderSettings& settings) {
   std::fprintf(stderr, "wrote %s: %dx%d, %d spp, %.2f s, %.2f Mrays/s%s\n", s.output.c_str(),
                result.image.width, result.image.height, s.spp, s.seconds, s.mrays_per_second(),
                settings.stats_file.empty() ? "" : fmt::format(", stats in {}", settings.stats_file).c_str());
+  if (result.interrupted_by) {
+    std::fprintf(stderr, "interrupted (%s) after %d spp: the image holds what was done%s\n",
+                 result.interrupted_by == SIGTERM ? "SIGTERM" : "SIGINT", s.spp,
+                 result.checkpoint.empty()
+                     ? ""
+                     : fmt::format("; continue with the same command and --resume {}", result.checkpoint).c_str());
+    return kExitInterrupted;
+  }
   return 0;
 }
 

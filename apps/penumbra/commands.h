@@ -5,6 +5,9 @@
 
 namespace penumbra::cli {
 
+/// Exit status of a render ended early by SIGINT or SIGTERM that wrote its image (and checkpoint):
+/// EX_TEMPFAIL, "try again" (a second signal exits with 128 + the signal's number instead).
+inline constexpr int kExitInterrupted = 75;
 /// Renders and writes outputs; returns the exit status.
 int run_render(const RenderSettings& settings);
 /// Lists every plugin on the search path with its parameters; returns the exit status.

@@ -57,6 +57,12 @@ int main(int argc, char** argv) {
   render->add_option("--aov", settings.aovs, "auxiliary outputs as EXR layers: albedo, normal, depth, samples, "
                      "variance, nonfinite, all")->delimiter(',');
   int spp_total = 0, spp_count = 0;
+  render->add_option("--checkpoint", settings.checkpoint_file, "write checkpoints to FILE (on SIGINT/SIGTERM, and with "
+                     "--checkpoint-every); default on interruption: the image's path + .checkpoint");
+  render->add_option("--checkpoint-every", settings.checkpoint_every, "also write a checkpoint after the first pass "
+                     "at least this many seconds after the previous one")->check(CLI::PositiveNumber);
+  render->add_option("--resume", settings.resume_file, "continue the render saved in this checkpoint (same scene and "
+                     "options: anything else is refused)");
   auto* total_opt = render->add_option("--spp-total", spp_total, "split render: samples per pixel of the whole render")->check(CLI::PositiveNumber);
   render->add_option("--spp-offset", settings.spp_offset, "split render: index of this part's first sample")->check(CLI::NonNegativeNumber)->needs(total_opt);
   auto* count_opt = render->add_option("--spp-count", spp_count, "split render: samples in this part (default: the rest)")->check(CLI::PositiveNumber)->needs(total_opt);
@@ -115,6 +121,7 @@ int main(int argc, char** argv) {
     if (*count_opt) settings.spp_count = spp_count;
     if (!res.empty()) settings.resolution = parse_resolution(res);
     for (const std::string& p : params) settings.integrator_params.push_back(penumbra::parse_param_override(p));
+    settings.handle_signals = true;
     return penumbra::cli::run_render(settings);
   } catch (const penumbra::Error& e) {
     std::fprintf(stderr, "%s\n", e.formatted().c_str());

@@ -13,8 +13,11 @@
 #include <penumbra/sampler.h>
 #include <penumbra/scene.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <type_traits>
+#include <vector>
 
 namespace penumbra {
 
@@ -73,6 +76,52 @@ class SplatSink {
   ~SplatSink() = default;
 };
 
+/// The byte stream of an integrator's own state in a checkpoint (SampleIntegrator::save_state).
+class StateWriter {
+ public:
+  virtual void write(const void* data, size_t bytes) = 0;
+  template <class T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    write(&v, sizeof v);
+  }
+  template <class T>
+  void vector(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    value<uint64_t>(v.size());
+    write(v.data(), v.size() * sizeof(T));
+  }
+
+ protected:
+  ~StateWriter() = default;
+};
+
+/// Reads back what a StateWriter wrote, in the same order; throws Error when the data run short.
+class StateReader {
+ public:
+  virtual void read(void* data, size_t bytes) = 0;
+  template <class T>
+  T value() {
+    static_assert(std::is_trivially_copyable_v<T>);
+    T v;
+    read(&v, sizeof v);
+    return v;
+  }
+  /// Reads a vector written by StateWriter::vector; throws Error unless it has `expected` elements.
+  template <class T>
+  void vector(std::vector<T>& v, uint64_t expected) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    uint64_t n = value<uint64_t>();
+    if (n != expected) mismatch(n, expected);
+    v.resize(n);
+    read(v.data(), n * sizeof(T));
+  }
+
+ protected:
+  ~StateReader() = default;
+  [[noreturn]] virtual void mismatch(uint64_t got, uint64_t expected) = 0;
+};
+
 /// One pixel sample as the render loop hands it over: the sampler has been started at
 /// (pixel, index) and has already given the film position and the lens position.
 struct PixelSample {
@@ -121,6 +170,14 @@ class SampleIntegrator : public Integrator {
   virtual bool film_holds_estimate() const { return true; }
   /// The current estimate, when the film does not hold it.
   virtual ImageRgb estimate() const { return {}; }
+
+  /// Checkpoints (penumbra render --checkpoint / --resume) are taken between passes. An integrator
+  /// whose next passes depend on more than (pixel, index, seed) and what begin_render() computes
+  /// (photon mapping's per-pixel statistics) saves that state here, after end_pass() ...
+  virtual void save_state(StateWriter& out) const {}
+  /// ... and reads it back after begin_render() when a render resumes, so that the resumed render
+  /// gives the uninterrupted render's image bit for bit.
+  virtual void load_state(StateReader& in) {}
 };
 
 /// Base for integrators whose pixel samples are independent estimates along the camera ray (path

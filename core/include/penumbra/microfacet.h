@@ -164,7 +164,7 @@ inline float fresnel_conductor(float cos_theta_i, float eta, float k) {
   return static_cast<float>(0.5 * (rs + rp));
 }
 
-/// The same with the complex IOR as one number (kept for plugins written against SDK 4.0).
+/// The same with the complex IOR as one number.
 inline float fresnel_complex(float cos_theta_i, std::complex<float> eta) {
   return fresnel_conductor(cos_theta_i, eta.real(), eta.imag());
 }

@@ -10,7 +10,7 @@
 #ifndef PENUMBRA_SDK_VERSION
 // 2: PluginInfo gained the compiler identity after sdk_version.
 // 3: Object gained statistics() (a new virtual function changes every plugin class's vtable).
-#define PENUMBRA_SDK_VERSION 4
+#define PENUMBRA_SDK_VERSION 5
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

@@ -126,4 +126,28 @@ std::vector<ImageLayer> FilmAovs::layers() const {
   return out;
 }
 
+void FilmAovs::save(StateWriter& out) const {
+  out.vector(weight_);
+  out.vector(count_);
+  out.vector(moments_);
+  out.vector(albedo_);
+  out.vector(normal_);
+  out.vector(depth_);
+  std::vector<uint32_t> nonfinite(nonfinite_ ? pixels_ : 0);
+  for (size_t i = 0; i < nonfinite.size(); ++i) nonfinite[i] = nonfinite_[i].load(std::memory_order_relaxed);
+  out.vector(nonfinite);
+}
+
+void FilmAovs::load(StateReader& in) {
+  in.vector(weight_, weight_.size());
+  in.vector(count_, count_.size());
+  in.vector(moments_, moments_.size());
+  in.vector(albedo_, albedo_.size());
+  in.vector(normal_, normal_.size());
+  in.vector(depth_, depth_.size());
+  std::vector<uint32_t> nonfinite;
+  in.vector(nonfinite, nonfinite_ ? pixels_ : 0);
+  for (size_t i = 0; i < nonfinite.size(); ++i) nonfinite_[i].store(nonfinite[i], std::memory_order_relaxed);
+}
+
 }  // namespace penumbra

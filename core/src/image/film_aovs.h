@@ -8,6 +8,7 @@
 
 #include <penumbra/error.h>
 #include <penumbra/film.h>
+#include <penumbra/integrator.h>
 
 #include <atomic>
 #include <memory>
@@ -38,6 +39,9 @@ class FilmAovs {
   void add_sample(size_t pixel, const Rgb& L, float weight);
   void add_surface(size_t pixel, const SurfaceSample& s, float weight);
   void add_nonfinite(size_t pixel);
+  /// Checkpoints: every accumulator, exactly.
+  void save(StateWriter& out) const;
+  void load(StateReader& in);
   /// The requested layers, in the documented order.
   std::vector<ImageLayer> layers() const;
 

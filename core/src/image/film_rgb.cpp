@@ -2,6 +2,7 @@
 
 #include "image/image_io.h"
 
+#include <penumbra/error.h>
 #include <penumbra/sampling.h>
 
 #include <fmt/core.h>
@@ -154,6 +155,23 @@ ImageRgb FilmRgb::image(double splat_spp) const {
     }
   }
   return img;
+}
+
+void FilmRgb::save(StateWriter& out) const {
+  out.vector(pixels_);
+  splats_.save(out);
+  out.value<uint64_t>(fireflies_.load());
+  out.value<uint8_t>(aovs_ ? 1 : 0);
+  if (aovs_) aovs_->save(out);
+}
+
+void FilmRgb::load(StateReader& in) {
+  in.vector(pixels_, pixels_.size());
+  splats_.load(in);
+  fireflies_.store(in.value<uint64_t>());
+  bool had_aovs = in.value<uint8_t>() != 0;
+  if (had_aovs != static_cast<bool>(aovs_)) throw Error("the checkpoint's film has other AOVs than this render's");
+  if (aovs_) aovs_->load(in);
 }
 
 }  // namespace penumbra

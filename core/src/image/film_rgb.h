@@ -62,6 +62,10 @@ class FilmRgb final : public Film {
   void set_firefly_threshold(float threshold) { firefly_threshold_ = threshold; }
   float firefly_threshold() const { return firefly_threshold_; }
   uint64_t firefly_count() const { return fireflies_.load(std::memory_order_relaxed); }
+  /// Checkpoints: pixel sums, splat sums, AOV accumulators and the firefly count, exactly; load()
+  /// expects a film made from the same scene and settings (sizes are checked).
+  void save(StateWriter& out) const;
+  void load(StateReader& in);
   /// The requested AOVs (empty when none were).
   AovSet aovs() const { return aovs_ ? aovs_->set() : AovSet{}; }
   std::vector<ImageLayer> aov_layers() const { return aovs_ ? aovs_->layers() : std::vector<ImageLayer>{}; }

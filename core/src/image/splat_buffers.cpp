@@ -62,27 +62,41 @@ bool SplatBuffers::add(int x, int y, const Rgb& v) {
   return true;
 }
 
-std::vector<double> SplatBuffers::totals() const {
-  std::vector<double> out(3 * static_cast<size_t>(resolution_.x) * resolution_.y, 0.0);
-  std::vector<Fixed> block_sum(kBlock * kBlock * 3);
+std::vector<SplatBuffers::Fixed> SplatBuffers::fixed_totals() const {
+  const size_t n = 3 * static_cast<size_t>(resolution_.x) * resolution_.y;
+  std::vector<Fixed> out = base_.empty() ? std::vector<Fixed>(n, Fixed(0)) : base_;
   for (int by = 0; by < blocks_y_; ++by)
     for (int bx = 0; bx < blocks_x_; ++bx) {
       size_t block = static_cast<size_t>(by) * blocks_x_ + bx;
-      bool touched = false;
-      std::fill(block_sum.begin(), block_sum.end(), Fixed(0));
-      for (const ThreadBuffer& tb : threads_)
-        if (!tb.blocks.empty() && tb.blocks[block]) {
-          touched = true;
-          for (size_t k = 0; k < block_sum.size(); ++k) block_sum[k] += tb.blocks[block]->v[k];
-        }
-      if (!touched) continue;
-      for (int y = by * kBlock; y < std::min((by + 1) * kBlock, resolution_.y); ++y)
-        for (int x = bx * kBlock; x < std::min((bx + 1) * kBlock, resolution_.x); ++x)
-          for (int c = 0; c < 3; ++c)
-            out[3 * (static_cast<size_t>(y) * resolution_.x + x) + c] =
-                static_cast<double>(block_sum[3 * ((y % kBlock) * kBlock + x % kBlock) + c]) / kScale;
+      for (const ThreadBuffer& tb : threads_) {
+        if (tb.blocks.empty() || !tb.blocks[block]) continue;
+        const Fixed* v = tb.blocks[block]->v;
+        for (int y = by * kBlock; y < std::min((by + 1) * kBlock, resolution_.y); ++y)
+          for (int x = bx * kBlock; x < std::min((bx + 1) * kBlock, resolution_.x); ++x)
+            for (int c = 0; c < 3; ++c)
+              out[3 * (static_cast<size_t>(y) * resolution_.x + x) + c] += v[3 * ((y % kBlock) * kBlock + x % kBlock) + c];
+      }
     }
   return out;
+}
+
+std::vector<double> SplatBuffers::totals() const {
+  std::vector<Fixed> sums = fixed_totals();
+  std::vector<double> out(sums.size());
+  for (size_t i = 0; i < sums.size(); ++i) out[i] = static_cast<double>(sums[i]) / kScale;
+  return out;
+}
+
+void SplatBuffers::save(StateWriter& out) const {
+  out.value<uint8_t>(any() ? 1 : 0);
+  if (any()) out.vector(fixed_totals());
+}
+
+void SplatBuffers::load(StateReader& in) {
+  bool had = in.value<uint8_t>() != 0;
+  if (!had) return;
+  in.vector(base_, 3 * static_cast<uint64_t>(resolution_.x) * resolution_.y);
+  any_.store(true, std::memory_order_relaxed);
 }
 
 }  // namespace penumbra

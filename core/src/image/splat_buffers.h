@@ -5,6 +5,7 @@
 #pragma once
 
 #include <penumbra/color.h>
+#include <penumbra/integrator.h>
 #include <penumbra/math.h>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -24,6 +25,9 @@ class SplatBuffers {
   /// The sum of every thread's splats, 3 values per pixel, row-major.
   std::vector<double> totals() const;
   bool any() const { return any_.load(std::memory_order_relaxed); }
+  /// Checkpoints: the exact integer sums (every thread's), and a restored base they add to.
+  void save(StateWriter& out) const;
+  void load(StateReader& in);
   /// Resolution of one unit: 2^-40 (values below ~1e-12 per splat round to zero).
   static constexpr double kScale = 0x1p40;
 
@@ -42,6 +46,8 @@ class SplatBuffers {
   uint64_t id_;  // unique per instance, so a thread's cached buffer is never another film's
   mutable tbb::enumerable_thread_specific<ThreadBuffer> threads_;
   std::atomic<bool> any_{false};
+  std::vector<Fixed> base_;  // sums restored from a checkpoint (empty unless resumed)
+  std::vector<Fixed> fixed_totals() const;
 };
 
 }  // namespace penumbra

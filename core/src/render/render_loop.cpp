@@ -4,6 +4,7 @@
 // bit whatever the thread count, and a part of a split render (indices [first_sample, first_sample +
 // spp)) takes exactly its share of them. Splats go to the film's per-thread fixed-point buffers,
 // whose integer sums do not depend on the order of the additions.
+#include "render/checkpoint.h"
 #include "render/surface_sample.h"
 
 #include <penumbra/integrator.h>
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <atomic>
 #include <memory>
+#include <optional>
 
 namespace penumbra {
 
@@ -59,6 +61,9 @@ void SampleIntegrator::render(RenderContext& ctx) {
   const uint64_t total = pixels * static_cast<uint64_t>(opt.spp);
   const bool surface_aovs = film.wants_surface_samples();
   begin_render(ctx);
+  // The runtime's context takes checkpoints between passes and may resume from one.
+  CheckpointHost* host = dynamic_cast<CheckpointHost*>(&ctx);
+  std::optional<ResumePoint> resumed = host ? host->resume(*this) : std::nullopt;
   // Asked after begin_render(), since they may depend on what it set up.
   const bool to_film = film_holds_estimate();
   const int max_pass = std::max(1, max_pass_samples());
@@ -69,15 +74,17 @@ void SampleIntegrator::render(RenderContext& ctx) {
   // What the runtime learns after each pass: whole passes done, what the splats are divided by (the
   // pixel samples actually taken over the pixel count) and, when the film does not hold it, where
   // the estimate comes from.
-  std::atomic<uint64_t> samples_taken{0};  // over all passes, cut ones included
-  int done_spp = 0;
+  int done_spp = resumed ? resumed->spp : 0;
+  std::atomic<uint64_t> samples_taken{static_cast<uint64_t>(done_spp) * pixels};  // cut passes included
   const std::function<ImageRgb()> estimate_fn = to_film ? std::function<ImageRgb()>() : [this] { return estimate(); };
   auto report = [&] {
     ctx.set_completed_spp(done_spp, estimate_fn, static_cast<double>(samples_taken.load()) / static_cast<double>(pixels));
   };
 
-  int pass_spp = 1;
-  while (done_spp < opt.spp && !ctx.should_stop()) {
+  int pass_spp = resumed ? resumed->pass_spp : 1;
+  if (resumed) report();
+  auto stop_requested = [&] { return host && host->stop_requested(); };
+  while (done_spp < opt.spp && !ctx.should_stop() && !stop_requested()) {
     Pass pass;
     pass.first_index = static_cast<uint32_t>(opt.first_sample + done_spp);
     pass.count = std::min({opt.spp - done_spp, pass_spp, max_pass});
@@ -129,7 +136,6 @@ void SampleIntegrator::render(RenderContext& ctx) {
     if (!pass.complete) break;
     done_spp += pass.count;
     report();
-    if (ctx.should_stop()) break;
     // Short passes first so a time budget is met closely, longer ones later for less overhead;
     // with a budget, a pass never takes much more than the time that is left.
     double now = ctx.elapsed();
@@ -138,6 +144,8 @@ void SampleIntegrator::render(RenderContext& ctx) {
       double per_spp = (now - pass_start) / pass.count;
       if (per_spp > 0.0) pass_spp = std::clamp(static_cast<int>((opt.time_budget - now) / per_spp), 1, pass_spp);
     }
+    if (host) host->pass_complete(ResumePoint{done_spp, pass_spp}, *this);
+    if (ctx.should_stop()) break;
   }
   // A pass cut short still adds its samples: pixel means stay unbiased, and the splats are divided
   // by the samples actually taken.

@@ -2,6 +2,8 @@
 
 #include "parser/scene_description.h"
 #include "registry/registry.h"
+#include "render/checkpoint.h"
+#include "render/interrupt.h"
 #include "render/progress.h"
 #include "render/ray_counter.h"
 #include "render/render_outputs.h"
@@ -44,16 +46,61 @@ uint64_t peak_memory_bytes() {
   return static_cast<uint64_t>(usage.ru_maxrss) * 1024u;
 }
 
-class Session final : public RenderContext {
+class Session final : public RenderContext, public CheckpointHost {
  public:
   Session(BuiltScene& built, RenderOptions options, const RenderSettings& settings)
       : built_(built), options_(options), settings_(settings), progress_("samples", settings.quiet) {}
+
+  /// Continues from a checkpoint: the film's sums now, the integrator's state in resume().
+  void restore(CheckpointData data) {
+    ByteReader film(data.film, fmt::format("--resume {}: film state", settings_.resume_file));
+    built_.film->load(film);
+    resumed_ = std::move(data);
+    resumed_seconds_ = resumed_->seconds;
+    nonfinite_.store(resumed_->nonfinite);
+    if (resumed_->first_nonfinite[0] >= 0) first_nonfinite_ = {resumed_->first_nonfinite[0], resumed_->first_nonfinite[1]};
+  }
+  void set_checkpoint(std::string path, CheckpointKey key) {
+    checkpoint_path_ = std::move(path);
+    key_ = std::move(key);
+  }
+
+  std::optional<ResumePoint> resume(SampleIntegrator& integrator) override {
+    if (!resumed_) return std::nullopt;
+    ByteReader in(resumed_->integrator, fmt::format("--resume {}: integrator state", settings_.resume_file));
+    integrator.load_state(in);
+    if (!in.at_end()) throw Error(fmt::format("--resume {}: the integrator's state has unexpected contents", settings_.resume_file));
+    return resumed_->point;
+  }
+  void pass_complete(const ResumePoint& next, const SampleIntegrator& integrator) override {
+    bool periodic = settings_.checkpoint_every > 0.0 && elapsed() - last_checkpoint_ >= settings_.checkpoint_every;
+    if (checkpoint_path_.empty() || !(periodic || stop_requested())) return;
+    auto t0 = Clock::now();
+    CheckpointData d;
+    d.key = key_;
+    d.point = next;
+    d.seconds = elapsed();
+    d.nonfinite = nonfinite_.load();
+    if (first_nonfinite_) d.first_nonfinite[0] = first_nonfinite_->first, d.first_nonfinite[1] = first_nonfinite_->second;
+    ByteWriter film, state;
+    built_.film->save(film);
+    integrator.save_state(state);
+    d.film = std::move(film.bytes());
+    d.integrator = std::move(state.bytes());
+    write_checkpoint(checkpoint_path_, d);
+    written_ = checkpoint_path_;
+    // Writing is not render time: a time budget is not eaten by checkpoints.
+    snapshot_seconds_ += seconds_since(t0);
+    last_checkpoint_ = elapsed();
+  }
+  bool stop_requested() const override { return settings_.handle_signals && InterruptGuard::signal_received() != 0; }
+  const std::string& checkpoint_written() const { return written_; }
 
   const Scene& scene() const override { return *built_.scene; }
   Film& film() override { return *built_.film; }
   const Sampler& sampler() const override { return *built_.sampler; }
   const RenderOptions& options() const override { return options_; }
-  double elapsed() const override { return seconds_since(start_) - snapshot_seconds_; }
+  double elapsed() const override { return resumed_seconds_ + seconds_since(start_) - snapshot_seconds_; }
   bool should_stop() const override {
     return options_.time_budget > 0.0 && elapsed() >= options_.time_budget;
   }
@@ -100,7 +147,27 @@ class Session final : public RenderContext {
   std::mutex mutex_;
   int completed_spp_ = 0;
   double splat_spp_ = 0.0;
+  std::optional<CheckpointData> resumed_;
+  double resumed_seconds_ = 0.0;
+  std::string checkpoint_path_, written_;
+  CheckpointKey key_;
+  double last_checkpoint_ = 0.0;
 };
+
+// What a checkpoint must agree on with the render that resumes it, besides the scene's fingerprint.
+CheckpointKey checkpoint_key(const std::string& hash, const BuiltScene& built, const RenderOptions& options,
+                             const SceneDescription& desc) {
+  CheckpointKey key;
+  key.scene_hash = hash;
+  Point2i res = built.film->resolution();
+  key.fields = {{"integrator", built.integrator_name},
+                {"sampler", built.sampler_name},
+                {"resolution", fmt::format("{}x{}", res.x, res.y)},
+                {"seed", std::to_string(desc.sampler.params.get_int("seed", 0))},
+                {"samples per pixel", options.spp == INT_MAX ? "until the time budget" : std::to_string(options.spp)},
+                {"first sample", std::to_string(options.first_sample)}};
+  return key;
+}
 
 // Replaces a plugin chosen by the scene with one named on the command line. Parameters the new
 // plugin also declares (maxdepth, pixelsamples, seed) carry over; the others are dropped, with a note.
@@ -335,12 +402,29 @@ RenderResult render(const RenderSettings& settings) {
   double load_seconds = seconds_since(t0);
 
   Session session(built, options, settings);
+  CheckpointKey key = checkpoint_key(hash, built, options, desc);
+  std::string checkpoint_path = settings.checkpoint_file;
+  if (checkpoint_path.empty() && settings.handle_signals)
+    checkpoint_path = (settings.output.empty() ? built.output_filename : settings.output) + ".checkpoint";
+  if (!checkpoint_path.empty())
+    check_checkpoint_path(checkpoint_path, settings.checkpoint_file.empty() ? "checkpoint of -o" : "--checkpoint");
+  session.set_checkpoint(checkpoint_path, key);
+  if (!settings.resume_file.empty()) {
+    if (!dynamic_cast<SampleIntegrator*>(built.integrator.get()))
+      throw Error(fmt::format("--resume: integrator '{}' does not run on the core's render loop and cannot resume",
+                              built.integrator_name));
+    session.restore(read_checkpoint(settings.resume_file, key));
+  }
+  std::optional<InterruptGuard> interrupts;
+  if (settings.handle_signals) interrupts.emplace();
   session.start();
   built.integrator->render(session);
   double seconds = session.elapsed();
   session.finish();
 
   RenderResult result;
+  result.interrupted_by = session.stop_requested() ? InterruptGuard::signal_received() : 0;
+  result.checkpoint = session.checkpoint_written();
   result.image = built.film->image(session.splat_spp());
   result.aovs = built.film->aov_layers();
   if (built.film->has_splats()) built.structures_built.push_back("film_splat_buffer");

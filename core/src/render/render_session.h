@@ -65,6 +65,14 @@ struct RenderSettings {
   std::optional<int> spp_total;
   int spp_offset = 0;
   std::optional<int> spp_count;
+  /// Checkpoints (docs/robustness.md): written atomically after the first complete pass at least
+  /// `checkpoint_every` seconds (0: never periodically) after the previous one, and when the render
+  /// is interrupted (to `checkpoint_file`, default: the image's path + ".checkpoint").
+  std::string checkpoint_file;           // --checkpoint FILE
+  double checkpoint_every = 0.0;         // --checkpoint-every SECONDS
+  std::string resume_file;               // --resume FILE: continue the render saved there
+  /// SIGINT/SIGTERM end the render after the current pass, with its image and a checkpoint.
+  bool handle_signals = false;
 };
 
 struct RenderStats {
@@ -94,6 +102,8 @@ struct RenderStats {
 };
 
 struct RenderResult {
+  int interrupted_by = 0;        // the signal that ended the render early, or 0
+  std::string checkpoint;        // the last checkpoint written, if any
   ImageRgb image;
   std::vector<ImageLayer> aovs;  // written with the beauty as EXR layers
   RenderStats stats;

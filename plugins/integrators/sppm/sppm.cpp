@@ -91,6 +91,8 @@ class SppmIntegrator final : public SampleIntegrator {
   Rgb sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink&) override;
   void end_pass(RenderContext& ctx, const Pass& pass) override;
   void end_render(RenderContext& ctx, int spp) override;
+  void save_state(StateWriter& out) const override;
+  void load_state(StateReader& in) override;
 
  private:
   void choose_initial_radius();
@@ -317,6 +319,24 @@ void SppmIntegrator::end_pass(RenderContext& ctx, const Pass& pass) {
       }
     });
   ++iterations_;
+}
+
+// Between iterations the per-pixel statistics are the whole state (visible points, the grid and
+// the photon sums are rebuilt by every iteration).
+void SppmIntegrator::save_state(StateWriter& out) const {
+  out.value<int32_t>(iterations_);
+  out.value<double>(emitted_);
+  out.value<uint8_t>(radius_chosen_ ? 1 : 0);
+  out.vector(stats_);
+  out.vector(vp_footprint_);
+}
+
+void SppmIntegrator::load_state(StateReader& in) {
+  iterations_ = in.value<int32_t>();
+  emitted_ = in.value<double>();
+  radius_chosen_ = in.value<uint8_t>() != 0;
+  in.vector(stats_, stats_.size());
+  in.vector(vp_footprint_, radius_chosen_ ? 0 : stats_.size());
 }
 
 ImageRgb SppmIntegrator::estimate() const {
