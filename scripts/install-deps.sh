@@ -13,6 +13,7 @@ packages=(
   git python3   # bench/integrators.sh: commit hash in its history, table and CSV (standard library only)
   clang-14 libclang-rt-14-dev
   chromium
+  slurm-wlm munge   # tests/farm/slurm_preempt_test.sh: a real single-node cluster
 )
 
 missing=()
