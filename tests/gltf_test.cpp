@@ -9,6 +9,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <cstring>
 
 using namespace penumbra;
@@ -36,11 +38,14 @@ const std::vector<uint32_t> kCubeIndices = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 
                                             3, 7, 6, 3, 6, 2, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
 
 // A glTF with one mesh (positions + uint32 indices) in a data-URI buffer. `nodes` is the JSON of
-// the node list; `mode` the primitive mode; `byte_length` lets a test truncate the buffer.
-std::string cube_gltf(const std::string& nodes, int mode = 4, int truncate_bytes = 0) {
+// the node list; `mode` the primitive mode; `byte_length` lets a test truncate the buffer;
+// `first_index` replaces the first vertex index.
+std::string cube_gltf(const std::string& nodes, int mode = 4, int truncate_bytes = 0,
+                      std::optional<uint32_t> first_index = std::nullopt) {
   std::vector<unsigned char> buf(kCubeP.size() * 4 + kCubeIndices.size() * 4);
   std::memcpy(buf.data(), kCubeP.data(), kCubeP.size() * 4);
   std::memcpy(buf.data() + kCubeP.size() * 4, kCubeIndices.data(), kCubeIndices.size() * 4);
+  if (first_index) std::memcpy(buf.data() + kCubeP.size() * 4, &*first_index, 4);
   size_t pbytes = kCubeP.size() * 4, ibytes = kCubeIndices.size() * 4;
   return fmt::format(R"({{
   "asset": {{"version": "2.0"}},
@@ -135,4 +140,8 @@ TEST(Gltf, BrokenFilesAreLocatedErrorsNamingTheFile) {
   expect_error("lines.gltf", cube_gltf(R"([{"mesh": 0}])", 1), "has mode 1; only triangles (4) are supported");
   expect_error("short.gltf", cube_gltf(R"([{"mesh": 0}])", 4, 8), "reads past the end of its buffer");
   expect_error("garbage.gltf", "{ not json", "cannot be read");
+  // Unsigned indices are reported as such (not as a negative int) and against the vertex count.
+  expect_error("index.gltf", cube_gltf(R"([{"mesh": 0}])", 4, 0, 0xFFFFFFFFu),
+               "mesh 'cube' primitive 0 has index 4294967295, but only 8 vertices");
+  expect_error("index8.gltf", cube_gltf(R"([{"mesh": 0}])", 4, 0, 8u), "has index 8, but only 8 vertices");
 }

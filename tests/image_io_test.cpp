@@ -252,5 +252,17 @@ TEST_F(ImageIo, OcioVariableSelectsAnotherConfig) {
   for (int v : read_bytes(path("a.png"))) ASSERT_NEAR(v, 128, 1);
 }
 
+TEST_F(ImageIo, HeadersClaimingHugeImagesAreRefusedBeforeAllocating) {
+  // A 100000 x 100000 PFM header over 64 bytes of data: 120 GB of floats if believed.
+  std::ofstream(path("huge.pfm"), std::ios::binary) << "PF\n100000 100000\n-1.0\n" << std::string(64, '\0');
+  std::string message = error_of([&] { read_image(path("huge.pfm")); });
+  EXPECT_NE(message.find("huge.pfm': 100000x100000 pixels with 3 channels is outside what Penumbra reads"),
+            std::string::npos)
+      << message;
+  // Control: a small image of the same format reads.
+  write_image(path("small.pfm"), gradient());
+  EXPECT_EQ(read_image(path("small.pfm")).width, gradient().width);
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -1,6 +1,6 @@
 // libFuzzer target for the scene parser: any input must either parse or raise penumbra::Error with a
 // message; a crash, a hang, an out-of-memory, a sanitizer report or any other exception is a bug.
-// Built and run by scripts/fuzz-parser.sh (clang, -fsanitize=fuzzer,address,undefined).
+// Built and run by scripts/fuzz.sh (clang, -fsanitize=fuzzer,address,undefined).
 #include "parser/scene_description.h"
 
 #include <cstddef>

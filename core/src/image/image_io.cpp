@@ -194,6 +194,13 @@ ImageRgb read_image(const std::string& path) {
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
   int channels = spec.nchannels;
+  // A damaged or hostile header must not make us allocate: 2^28 pixels (1 GiB of RGB floats) at most.
+  constexpr double kMaxPixels = 268435456.0;
+  if (spec.width <= 0 || spec.height <= 0 || channels <= 0 || channels > 64 ||
+      static_cast<double>(spec.width) * spec.height > kMaxPixels)
+    throw Error(fmt::format("cannot read image '{}': {}x{} pixels with {} channels is outside what Penumbra reads "
+                            "(at most {:.0f} pixels)",
+                            path, spec.width, spec.height, channels, kMaxPixels));
   std::vector<float> all(size_t(spec.width) * spec.height * channels);
   if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data()))
     throw Error(fmt::format("cannot read image '{}': {}", path, in->geterror()));

@@ -140,7 +140,12 @@ std::vector<GltfPrimitive> load_gltf(const std::string& path, const FileLoc& loc
           for (size_t i = 0; i < t.size(); i += 2) g.uv.push_back(Vec2(t[i], t[i + 1]));
         }
         if (prim.indices >= 0) {
-          for (double v : reader.read(prim.indices, 1, (what + " indices").c_str())) g.indices.push_back(static_cast<int>(v));
+          for (double v : reader.read(prim.indices, 1, (what + " indices").c_str())) {
+            // Indices are unsigned in glTF: checked against the vertex count before any conversion.
+            if (!(v >= 0.0 && v < static_cast<double>(g.P.size())))
+              reader.fail(fmt::format("{} has index {:.0f}, but only {} vertices", what, v, g.P.size()));
+            g.indices.push_back(static_cast<int>(v));
+          }
         } else {
           for (size_t i = 0; i < g.P.size(); ++i) g.indices.push_back(static_cast<int>(i));
         }
