@@ -2,9 +2,9 @@
 // stops within one batch of photons, so every integrator ends within about one tile batch of T, SPPM
 // with its default (footprint-derived) radius at 512x512 included, and with a radius of half the box
 // (every photon then lands on most visible points: 10 ms per photon). These bound how far a render
-// may overrun its own budget (a property of the loop), not how fast anything renders.
-// Not covered: bdpt with probconnect, whose pilot (cache points x pcrecords connection weights,
-// 2.4 s at 512x512) runs before the first pass and is not cut.
+// may overrun its own budget (a property of the loop), not how fast anything renders. bdpt with
+// probconnect included: its pilot and per-iteration records (cache points x pcrecords connection
+// weights, seconds at 512x512) stop within one batch of cache points.
 #include "support/bundled_scenes.h"
 #include "support/command.h"
 
@@ -44,6 +44,8 @@ INSTANTIATE_TEST_SUITE_P(
                       BudgetCase{"bdpt", "Integrator \"bdpt\" \"integer maxdepth\" [ 8 ]"},
                       BudgetCase{"bdpt_hrr_default", "Integrator \"bdpt\" \"bool hrr\" true"},
                       BudgetCase{"bdpt_hrr_every_vertex", "Integrator \"bdpt\" \"bool hrr\" true \"float hrrmaxalpha\" 1"},
+                      BudgetCase{"bdpt_probconnect", "Integrator \"bdpt\" \"bool probconnect\" true"},
+                      BudgetCase{"bdpt_hrr_probconnect", "Integrator \"bdpt\" \"bool hrr\" true \"bool probconnect\" true"},
                       BudgetCase{"lighttracing", "Integrator \"lighttracing\""},
                       BudgetCase{"sppm_default_radius", "Integrator \"sppm\" \"integer maxdepth\" [ 8 ]"},
                       BudgetCase{"sppm_radius_1", "Integrator \"sppm\" \"float radius\" [ 1 ]"}),

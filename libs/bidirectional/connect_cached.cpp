@@ -124,8 +124,7 @@ struct EyeMemo {
   Vec3 z{0.f}, z_next{0.f}, n{0.f};
   const Bsdf* bsdf = nullptr;
   std::optional<HrrRange> range;  // empty: HRR does not apply at z
-  int cache_point = -1;
-  bool has_range = false, has_cache_point = false;
+  bool has_range = false;
 };
 
 EyeMemo& eye_memo(uint64_t owner, const Vertex& z, const Vertex& z_next) {
@@ -161,13 +160,29 @@ const std::optional<HrrRange>& CachedConnector::eye_range(const Vertex& z, const
   return memo.range;
 }
 
-int CachedConnector::eye_cache_point(const Vertex& z, const Vertex& z_next) const {
-  EyeMemo& memo = eye_memo(id_, z, z_next);
-  if (!memo.has_cache_point) {
-    memo.cache_point = pc_.lookup(z.p, z.ng);
-    memo.has_cache_point = true;
+// The cache point depends on z alone (not on its neighbour, as HRR's range does), so it has a memo
+// of its own: the MIS weights ask for the same vertex with many neighbours.
+int CachedConnector::eye_cache_point(const Vertex& z, const Vertex&) const {
+  struct PointMemo {
+    uint64_t owner = 0;
+    Vec3 p{0.f}, n{0.f};
+    int cache_point = -1;
+  };
+  thread_local std::array<PointMemo, 64> memo;
+  auto bits = [](float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+  };
+  uint64_t h = hash_ints(id_, bits(z.p.x) ^ (uint64_t(bits(z.p.y)) << 32), bits(z.p.z) ^ (uint64_t(bits(z.ng.x)) << 32));
+  PointMemo& m = memo[h & 63];
+  if (m.owner != id_ || m.p != z.p || m.n != z.ng) {
+    m.owner = id_;
+    m.p = z.p;
+    m.n = z.ng;
+    m.cache_point = pc_.lookup(z.p, z.ng);
   }
-  return memo.cache_point;
+  return m.cache_point;
 }
 
 double CachedConnector::factor(Technique tau, const Vertex& y_prev, const Vertex& y, const Vertex& z,
@@ -185,15 +200,19 @@ double CachedConnector::factor(Technique tau, const Vertex& y_prev, const Vertex
   return 0.0;
 }
 
-void CachedConnector::prepare(const Context& ctx, const Sampler& proto, Point2i resolution) {
+bool CachedConnector::prepare(const Context& ctx, const Sampler& proto, Point2i resolution,
+                              const std::function<bool()>& stop) {
+  auto cut = [&] { return stop && stop(); };
   auto t0 = std::chrono::steady_clock::now();
   M_ = opt_.light_paths ? opt_.light_paths : static_cast<size_t>(resolution.x) * resolution.y;
   // A pilot cache, independent of the render's samples.
   StreamSampler pilot(hash_ints(opt_.seed, 0x50434143u /* "PCAC" */));
-  cache_.trace(ctx, pilot, resolution, 0xfffffffeu, M_, opt_.seed ^ 0x9e3779b97f4a7c15ull);
+  cache_.trace(ctx, pilot, resolution, 0xfffffffeu, M_, opt_.seed ^ 0x9e3779b97f4a7c15ull, stop);
+  if (cut()) return false;
   std::vector<Vertex> eye, eye_next;
   pilot_eye_vertices(ctx, resolution, 4, opt_.seed, &eye, &eye_next);
-  if (opt_.hrr) calibrate(eye, eye_next);
+  if (opt_.hrr) calibrate(eye, eye_next, stop);
+  if (cut()) return false;
   if (opt_.probconnect) {
     std::vector<CachePoint> points;
     for (const Vertex& v : eye) points.push_back(CachePoint{v.p, v.ng});
@@ -203,13 +222,16 @@ void CachedConnector::prepare(const Context& ctx, const Sampler& proto, Point2i 
     pc_radius_ = points.empty() ? 1.f : 2.f * diagonal / std::sqrt(static_cast<float>(points.size()));
     if (!(pc_radius_ > 0.f) || !std::isfinite(pc_radius_)) pc_radius_ = 1.f;
     pc_.build_points(std::move(points), pc_radius_, ConnectionCache::Options{opt_.pc_records, 0.2});
-    build_records(0xfffffffeu);
+    build_records(0xfffffffeu, stop);
+    if (cut()) return false;
     pc_.freeze_statistics();
   }
   calibration_seconds_ = seconds_since(t0);
+  return true;
 }
 
-void CachedConnector::calibrate(const std::vector<Vertex>& eye, const std::vector<Vertex>& eye_next) {
+void CachedConnector::calibrate(const std::vector<Vertex>& eye, const std::vector<Vertex>& eye_next,
+                                const std::function<bool()>& stop) {
   if (opt_.hrr_c > 0.0) {
     C_ = opt_.hrr_c;
     return;
@@ -245,26 +267,32 @@ void CachedConnector::calibrate(const std::vector<Vertex>& eye, const std::vecto
   };
   double target = std::min(opt_.hrr_target, static_cast<double>(V));
   double lo = 1.0, hi = 1.0;
-  for (int i = 0; i < 200 && mean_count(lo) >= target; ++i) lo *= 0.01;
-  for (int i = 0; i < 200 && mean_count(hi) < target; ++i) hi *= 100.0;
-  for (int i = 0; i < 40; ++i) {
+  auto cut = [&] { return stop && stop(); };
+  for (int i = 0; i < 200 && !cut() && mean_count(lo) >= target; ++i) lo *= 0.01;
+  for (int i = 0; i < 200 && !cut() && mean_count(hi) < target; ++i) hi *= 100.0;
+  for (int i = 0; i < 40 && !cut(); ++i) {
     double mid = std::sqrt(lo * hi);
     (mean_count(mid) < target ? lo : hi) = mid;
   }
   C_ = hi;
 }
 
-void CachedConnector::build_records(uint32_t index) {
-  pc_.build_records(cache_.vertex_count(), opt_.seed, index, [&](int cp, uint32_t v) {
-    LightCache::Ref r = cache_.ref(v);
-    const Vertex* path = cache_.path(r.path);
-    return pc_weight(path[r.vertex - 1], path[r.vertex], cp);
-  });
+void CachedConnector::build_records(uint32_t index, const std::function<bool()>& stop) {
+  pc_.build_records(
+      cache_.vertex_count(), opt_.seed, index,
+      [&](int cp, uint32_t v) {
+        LightCache::Ref r = cache_.ref(v);
+        const Vertex* path = cache_.path(r.path);
+        return pc_weight(path[r.vertex - 1], path[r.vertex], cp);
+      },
+      stop);
 }
 
-void CachedConnector::begin_iteration(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index) {
+void CachedConnector::begin_iteration(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index,
+                                      const std::function<bool()>& stop) {
   auto t0 = std::chrono::steady_clock::now();
-  cache_.trace(ctx, proto, resolution, index, M_, opt_.seed);
+  cache_.trace(ctx, proto, resolution, index, M_, opt_.seed, stop);
+  if (stop && stop()) return;
   trace_seconds_ += seconds_since(t0);
   ++iterations_;
   cached_vertices_ += cache_.vertex_count();
@@ -275,7 +303,7 @@ void CachedConnector::begin_iteration(const Context& ctx, const Sampler& proto, 
     bvh_bytes_ = bvh_.memory_bytes();
     bvh_vertices_ = bvh_.vertex_count();
   }
-  if (opt_.probconnect) build_records(index);
+  if (opt_.probconnect) build_records(index, stop);
 }
 
 void CachedConnector::connect_eye_vertex(const Context& ctx, const Vertex* camera, int t, Point2i pixel,

@@ -53,9 +53,13 @@ class CachedConnector final : public CachedTechniques {
 
   /// Before the render: a pilot cache and pilot camera paths fix C (calibration), the cache points
   /// of probabilistic connections and their frozen statistics.
-  void prepare(const Context& ctx, const Sampler& proto, Point2i resolution);
-  /// Before iteration `index`: traces the cache, rebuilds the BVH and the records.
-  void begin_iteration(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index);
+  /// `stop` (the render's time budget is spent) cuts the work short; the render then takes no
+  /// sample with what is left. Returns false when it was cut.
+  bool prepare(const Context& ctx, const Sampler& proto, Point2i resolution, const std::function<bool()>& stop = {});
+  /// Before iteration `index`: traces the cache, rebuilds the BVH and the records (cut short by
+  /// `stop` as prepare() is).
+  void begin_iteration(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index,
+                       const std::function<bool()>& stop = {});
 
   const LightCache& cache() const { return cache_; }
   const ConnectionCache& connection_cache() const { return pc_; }
@@ -87,8 +91,9 @@ class CachedConnector final : public CachedTechniques {
   std::vector<std::pair<std::string, double>> statistics() const;
 
  private:
-  void calibrate(const std::vector<Vertex>& eye_vertices, const std::vector<Vertex>& eye_next);
-  void build_records(uint32_t index);
+  void calibrate(const std::vector<Vertex>& eye_vertices, const std::vector<Vertex>& eye_next,
+                 const std::function<bool()>& stop);
+  void build_records(uint32_t index, const std::function<bool()>& stop);
 
   CachedOptions opt_;
   int max_depth_;

@@ -15,13 +15,14 @@ void StreamSampler::start_pixel_sample(Point2i pixel, uint32_t index, uint32_t d
 }
 
 void LightCache::trace(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index, size_t M,
-                       uint64_t seed) {
+                       uint64_t seed, const std::function<bool()>& stop) {
   size_t pixels = static_cast<size_t>(resolution.x) * resolution.y;
   vertices_.resize(M * stride_);
   lengths_.assign(M, 0);
   tbb::enumerable_thread_specific<std::unique_ptr<Sampler>> samplers([&] { return proto.clone(); });
   tbb::enumerable_thread_specific<StreamSampler> streams(hash_ints(seed, 0x4c43u /* "LC" */));
   tbb::parallel_for(tbb::blocked_range<size_t>(0, M, 256), [&](const tbb::blocked_range<size_t>& r) {
+    if (stop && stop()) return;
     for (size_t j = r.begin(); j < r.end(); ++j) {
       Point2i pixel;
       Sampler* sampler;

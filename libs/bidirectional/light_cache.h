@@ -14,6 +14,7 @@
 #include <penumbra/rng.h>
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -25,7 +26,10 @@ class LightCache {
 
   /// Traces the M paths of the iteration whose pixel samples have index `index`. `proto` is the
   /// render's sampler (cloned per thread); `resolution` gives the pixel of path j < pixel count.
-  void trace(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index, size_t M, uint64_t seed);
+  /// When `stop` says so (the time budget is spent) tracing ends early: the cache is then incomplete
+  /// and must not be rendered with.
+  void trace(const Context& ctx, const Sampler& proto, Point2i resolution, uint32_t index, size_t M, uint64_t seed,
+             const std::function<bool()>& stop = {});
 
   size_t path_count() const { return lengths_.size(); }
   const Vertex* path(size_t j) const { return &vertices_[j * stride_]; }

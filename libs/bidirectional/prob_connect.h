@@ -52,6 +52,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -94,7 +95,8 @@ class ConnectionCache {
   /// must be thread-safe. Negative or non-finite weights count as 0. Throws std::length_error if
   /// vertex_count does not fit in 32 bits.
   template <class Weight>
-  void build_records(size_t vertex_count, uint64_t seed, uint64_t iteration, Weight&& weight);
+  void build_records(size_t vertex_count, uint64_t seed, uint64_t iteration, Weight&& weight,
+                     const std::function<bool()>& stop = {});
 
   /// Freezes V_f and wbar_f(c) from the most recent build_records() for approx_probability(). Only
   /// the first call after build_points() has an effect; throws std::logic_error before any build.
@@ -160,10 +162,13 @@ class ConnectionCache {
 };
 
 template <class Weight>
-void ConnectionCache::build_records(size_t vertex_count, uint64_t seed, uint64_t iteration, Weight&& weight) {
+void ConnectionCache::build_records(size_t vertex_count, uint64_t seed, uint64_t iteration, Weight&& weight,
+                                    const std::function<bool()>& stop) {
   begin_records(vertex_count);
   if (slots_per_point_ == 0) return;
+  // `stop` (the time budget is spent) leaves the records incomplete: not to be rendered with.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, points_.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
+    if (stop && stop()) return;
     for (size_t cp = range.begin(); cp != range.end(); ++cp) {
       std::span<const uint32_t> vertices = draw_records(cp, seed, iteration);
       std::span<double> w = slot_storage(cp);

@@ -458,6 +458,13 @@ RenderResult render(const RenderSettings& settings) {
   s.aovs = built.film->aovs().names();
   s.integrator_stats = built.integrator->statistics();
   for (const ParamOverride& o : settings.integrator_params) s.integrator_params.emplace_back(o.name, o.value);
+  if (s.spp == 0 && session.splat_spp() == 0.0 && !result.interrupted_by)
+    warning({}, fmt::format("no pass was completed{}: the image is black",
+                            settings.time_budget > 0.0
+                                ? fmt::format(" within the time budget of {:g} s (the integrator's preparation, e.g. a "
+                                              "pilot, took it all)",
+                                              settings.time_budget)
+                                : ""));
   if (s.nonfinite_samples > 0)
     warning({}, fmt::format("{} non-finite samples were discarded (first at pixel {}, {})",
                             s.nonfinite_samples, s.first_nonfinite_pixel->first,

@@ -184,10 +184,11 @@ class BdptIntegrator final : public SampleIntegrator {
       images_ = std::make_unique<tbb::enumerable_thread_specific<StrategyImages>>(
           [this] { return StrategyImages(res_, config_.max_depth); });
     if (cached_) {
-      cached_->prepare(*ctx_, rc.sampler(), res_);
+      // The pilot stops when the time budget is spent; the render then takes no sample.
+      bool whole = cached_->prepare(*ctx_, rc.sampler(), res_, [&rc] { return rc.should_stop(); });
       // HRR alone where no eye vertex may use it would only cost time (a cache, a BVH and one sample
       // per pass): render plain bdpt instead, which samples the same paths.
-      if (cached_options_.hrr && !cached_options_.probconnect && !cached_->hrr_eligible()) {
+      if (whole && cached_options_.hrr && !cached_options_.probconnect && !cached_->hrr_eligible()) {
         warning({}, fmt::format("bdpt: hrr is on, but no eye vertex of the pilot has a non-specular lobe with "
                                 "alpha <= hrrmaxalpha ({:g}); rendering without the light-vertex cache",
                                 cached_options_.hrr_max_alpha));
@@ -203,7 +204,8 @@ class BdptIntegrator final : public SampleIntegrator {
   int max_pass_samples() const override { return cached_ ? 1 : 16; }
 
   void begin_pass(RenderContext& rc, const Pass& pass) override {
-    if (cached_) cached_->begin_iteration(*ctx_, rc.sampler(), res_, pass.first_index);
+    // Cut short when the time budget runs out; the loop then renders no tile of this pass.
+    if (cached_) cached_->begin_iteration(*ctx_, rc.sampler(), res_, pass.first_index, [&rc] { return rc.should_stop(); });
   }
 
   Rgb sample(const Scene& scene, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
