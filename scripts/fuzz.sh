@@ -35,16 +35,17 @@ build_target() {
   esac
 }
 
+# Seeds are named after their path: many bundled files share a base name (scene.pbrt).
 seed_corpus() {
   local dir="$2" f
   case "$1" in
-    parser) find scenes -name '*.pbrt' -exec cp {} "$dir/" \; ;;
-    ply) find scenes tests -name '*.ply' -size -200k -exec cp {} "$dir/" \; ;;
-    gltf) for f in $(find scenes tests -name '*.gltf' -size -200k); do
-            { printf '\0'; cat "$f"; } >"$dir/$(basename "$f")"
+    parser) for f in $(find scenes -name '*.pbrt'); do cp "$f" "$dir/${f//\//_}"; done ;;
+    ply) for f in $(find scenes tests -name '*.ply' -size -200k); do cp "$f" "$dir/${f//\//_}"; done ;;
+    gltf) for f in $(find scenes tests -name '*.gltf' -size -200k); do  # first byte 0: read as .gltf
+            { printf '\0'; cat "$f"; } >"$dir/${f//\//_}"
           done ;;
     image) for f in $(find tests/data scenes -name '*.exr' -size -64k); do  # first byte 0: .exr
-             { printf '\0'; cat "$f"; } >"$dir/$(basename "$f")"
+             { printf '\0'; cat "$f"; } >"$dir/${f//\//_}"
            done ;;
   esac
 }
