@@ -196,11 +196,6 @@ TEST(ParserErrors, TextureParameterTypeIsNotSupported) {
                "parameter type 'texture' is not supported");
 }
 
-TEST(ParserErrors, BlackbodyParameterTypeIsNotSupported) {
-  expect_error("WorldBegin\nLightSource \"point\" \"blackbody I\" 5500", 2, 21,
-               "parameter type 'blackbody' is not supported");
-}
-
 TEST(ParserErrors, BadParameterDeclaration) {
   expect_error("WorldBegin\nShape \"sphere\" \"radius\" 1", 2, 16,
                "bad parameter declaration \"radius\": expected \"type name\"");
@@ -241,14 +236,29 @@ TEST(ParserErrors, DuplicateParameter) {
                "parameter 'radius' given twice (first at scene.pbrt:2:16)");
 }
 
-TEST(ParserErrors, SpectrumGivenAsANamedSpectrum) {
-  expect_error("WorldBegin\nLightSource \"point\" \"spectrum I\" \"stdillum-D65\"", 2, 34,
-               "spectrum 'I' must be given as 3 RGB values");
+TEST(ParserErrors, UnknownSpectrumNameListsTheClosestNames) {
+  expect_error("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-Ag-et\"", 2, 22,
+               "unknown spectrum 'metal-Ag-et' for parameter 'eta': not one of pbrt-v4's named spectra");
+  std::string f = formatted_error(
+      [] { parse_scene_string("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-Ag-et\"", "scene.pbrt"); });
+  EXPECT_THAT(f, HasSubstr("closest names: 'metal-Ag-eta', 'metal-Ag-k', "));
 }
 
-TEST(ParserErrors, SpectrumGivenAsWavelengthValuePairs) {
-  expect_error("WorldBegin\nLightSource \"point\" \"spectrum I\" [ 300 1 800 1 ]", 2, 21,
-               "spectrum 'I' must be given as 3 RGB values");
+TEST(ParserErrors, SpectrumPairsNeedAnEvenCount) {
+  expect_error("WorldBegin\nLightSource \"point\" \"spectrum I\" [ 300 1 800 1 900 ]", 2, 21,
+               "spectrum 'I' takes 3 RGB values or at least two (wavelength, value) pairs, got 5 values");
+}
+
+TEST(ParserErrors, SpectrumWavelengthsMustIncrease) {
+  expect_error("WorldBegin\nLightSource \"point\" \"spectrum I\" [ 500 1 400 1 ]", 2, 21,
+               "spectrum 'I': wavelengths must increase, but 400 follows 500");
+}
+
+TEST(ParserErrors, BlackbodyTakesOneTemperature) {
+  expect_error("WorldBegin\nLightSource \"point\" \"blackbody I\" [ 3000 2 ]", 2, 21,
+               "blackbody 'I' takes one temperature in kelvin, got 2 values");
+  expect_error("WorldBegin\nLightSource \"point\" \"blackbody I\" [ -5 ]", 2, 21,
+               "blackbody 'I' needs a temperature > 0 K, got -5");
 }
 
 TEST(ParserErrors, ParameterWithoutValue) {

@@ -21,6 +21,9 @@ namespace penumbra {
 /// "point3", "vector3", "normal"), name, default value as scene-file text ("5", "0.5 0.5 0.5",
 /// "true", "box"; empty when there is none) and a one-line description.
 /// A type ending in "[]" ("point3[]") takes any number of values (meshes); others take one value.
+/// Type "float|spectrum" takes one float or a spectrum ("spectrum", "rgb" or "blackbody": pbrt-v4's
+/// dielectric "eta"); get_float() then returns the spectrum's luminance-weighted mean (the Y of its
+/// RGB), since one value is all an RGB renderer can refract with.
 /// Type "unsupported" declares a pbrt parameter Penumbra knows but does not implement: giving it is
 /// an error that says so (the doc text explains why or what to use instead).
 struct ParamSpec {
@@ -32,10 +35,11 @@ struct ParamSpec {
 
 /// One parameter as written in a scene file, with its location.
 struct Param {
-  std::string type;   // as written: "float", "rgb", "spectrum", "point3", ...
+  std::string type;   // as written: "float", "rgb", "spectrum", "blackbody", "point3", ...
   std::string name;
   FileLoc loc;
-  std::vector<double> numbers;       // integer, float, rgb, point, vector, normal values
+  std::vector<double> numbers;       // integer, float, rgb, point, vector, normal values; the RGB
+                                     // of a spectrum or blackbody (converted when the scene is read)
   std::vector<std::string> strings;  // string values
   std::vector<bool> bools;           // bool values
   size_t count() const { return numbers.size() + strings.size() + bools.size(); }

@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 
 #include "parser/param_list.h"
+#include "parser/spectrum_params.h"
 
 namespace penumbra {
 
@@ -24,7 +25,7 @@ SceneEntity SceneParser::make_entity(const Token& d, const char* what) {
 SceneEntity SceneParser::entity_at(const Token& d, std::string type, ParamSet params) {
   SceneEntity e;
   e.type = std::move(type);
-  e.params = std::move(params);
+  e.params = resolve_spectra(params, spectrum_use_of(d.text), base_dir_);
   e.loc = d.loc;
   e.base_dir = base_dir_;
   e.to_world = Mat4(state_.ctm);

@@ -20,7 +20,7 @@ struct TypeInfo {
   ValueKind kind;
 };
 
-constexpr std::array<TypeInfo, 14> kTypes{{
+constexpr std::array<TypeInfo, 15> kTypes{{
     {"integer", ValueKind::Integer},
     {"float", ValueKind::Number},
     {"point2", ValueKind::Number},
@@ -35,10 +35,11 @@ constexpr std::array<TypeInfo, 14> kTypes{{
     {"bool", ValueKind::Bool},
     {"string", ValueKind::String},
     {"spectrum", ValueKind::Spectrum},
+    {"blackbody", ValueKind::Number},
 }};
 
-// pbrt-v4 types that Penumbra knowingly leaves out (no textures, no spectral rendering).
-constexpr std::array<std::string_view, 2> kUnsupportedTypes{"texture", "blackbody"};
+// pbrt-v4 types that Penumbra knowingly leaves out.
+constexpr std::array<std::string_view, 1> kUnsupportedTypes{"texture"};
 
 std::string suggest_type(const std::string& given) {
   std::string best;
@@ -104,9 +105,11 @@ void add_value(Param& p, ValueKind kind, const Token& v) {
       p.strings.push_back(v.text);
       return;
     case ValueKind::Spectrum:
-      // Named spectra ("metal-Cu-eta") and sampled spectra need spectral rendering.
-      if (v.kind == TokenKind::String)
-        throw Error(v.loc, fmt::format("spectrum '{}' must be given as 3 RGB values", p.name));
+      // A name ("metal-Cu-eta") or .spd file, or numbers; parser/spectrum_params.cpp makes RGB of them.
+      if (v.kind == TokenKind::String) {
+        p.strings.push_back(v.text);
+        return;
+      }
       add_number(p, kind, v);
       return;
     default: add_number(p, kind, v); return;
@@ -152,8 +155,6 @@ Param parse_param(Tokenizer& tok) {
   } else {
     throw Error(p.loc, fmt::format("parameter '{}' has no value", p.name));
   }
-  if (kind == ValueKind::Spectrum && p.numbers.size() != 3)
-    throw Error(p.loc, fmt::format("spectrum '{}' must be given as 3 RGB values", p.name));
   return p;
 }
 

@@ -61,7 +61,10 @@ static std::pair<std::string, bool> spec_base(const std::string& type) {
 // Scene-file types a spec type accepts (pbrt-v4 spellings and synonyms).
 static bool type_accepts(const std::string& spec, const std::string& given) {
   if (spec == given) return true;
-  if (spec == "rgb") return given == "spectrum";
+  // Spectra and blackbodies reach plugins as RGB (parser/spectrum_params.cpp converts them).
+  if (spec == "rgb") return given == "spectrum" || given == "blackbody";
+  if (spec == "float|spectrum")
+    return given == "float" || given == "spectrum" || given == "blackbody" || given == "rgb";
   if (spec == "point3") return given == "point";
   if (spec == "vector3") return given == "vector";
   if (spec == "normal") return given == "normal3";
@@ -121,6 +124,7 @@ void ParamSet::validate(std::span<const ParamSpec> spec, const std::string& what
       throw Error(p.loc, fmt::format("parameter '{}' of {} must have type '{}', not '{}'", p.name,
                                      what, base, p.type));
     size_t n = p.count(), k = static_cast<size_t>(components(base));
+    if (base == "float|spectrum" && p.type != "float") k = 3;
     if (!array && n != k)
       throw Error(p.loc, fmt::format("parameter '{}' of {} takes {} value{}, got {}", p.name, what, k,
                                      k == 1 ? "" : "s", n));
@@ -148,6 +152,8 @@ int ParamSet::get_int(const std::string& name, int fallback) const {
 }
 float ParamSet::get_float(const std::string& name, float fallback) const {
   const Param* p = find_or_default(name);
+  if (p && p->type != "float" && p->numbers.size() == 3)  // a "float|spectrum" given as a spectrum
+    return luminance(Rgb(p->numbers[0], p->numbers[1], p->numbers[2]));
   return p && !p->numbers.empty() ? static_cast<float>(p->numbers[0]) : fallback;
 }
 bool ParamSet::get_bool(const std::string& name, bool fallback) const {

@@ -31,7 +31,7 @@ const ParamSpec kParams[] = {
     {"float", "vroughness", "", "coat roughness along t (default: roughness)"},
     {"bool", "remaproughness", "true", "alpha = sqrt(roughness) when true, alpha = roughness otherwise"},
     {"float", "thickness", "0.01", "coat thickness: accepted and ignored (no absorption modelled)"},
-    {"float", "eta", "1.5", "coat index of refraction"},
+    {"float|spectrum", "eta", "1.5", "coat index of refraction; a spectrum gives its luminance-weighted mean"},
     {"unsupported", "albedo", "", "a scattering coat layer is not supported"},
     {"unsupported", "g", "", "a scattering coat layer is not supported"},
     {"unsupported", "maxdepth", "", "the layers are approximated, not random-walked"},

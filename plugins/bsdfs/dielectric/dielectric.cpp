@@ -153,7 +153,7 @@ class DielectricBsdf final : public Bsdf {
 };
 
 const ParamSpec kParams[] = {
-    {"float", "eta", "1.5", "index of refraction inside relative to outside (one value: no dispersion)"},
+    {"float|spectrum", "eta", "1.5", "index of refraction inside relative to outside; a spectrum gives its luminance-weighted mean (no dispersion)"},
     {"float", "roughness", "0", "isotropic microfacet roughness (0: smooth)"},
     {"float", "uroughness", "", "roughness along the shading frame's s axis (default: roughness)"},
     {"float", "vroughness", "", "roughness along the shading frame's t axis (default: roughness)"},
