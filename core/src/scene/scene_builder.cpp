@@ -1,4 +1,5 @@
 #include "scene/scene_builder.h"
+#include "scene/composite_materials.h"
 
 #include "parser/ply_reader.h"
 #include "scene/gltf_loader.h"
@@ -167,9 +168,14 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   // Materials, in file order; the default one only if some shape needs it.
   for (auto& m : desc.materials) {
     if (m.type.empty()) throw Error(m.loc, "material has no type");
+    if (is_composite_material(m.type)) {  // "mix" and "interface": built below from the others
+      out.bsdfs.push_back(nullptr);
+      continue;
+    }
     out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params,
                                               CreateContext{m.params, {}, m.base_dir}, m.loc));
   }
+  build_composite_materials(desc, out.bsdfs);
   const Bsdf* default_bsdf = nullptr;
   ParamSet default_params;
   auto material_of = [&](const ShapeEntity& s) -> const Bsdf* {
@@ -229,6 +235,10 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights));
   };
   for (auto& s : desc.shapes) {
+    if (!material_of(s)) {  // "interface": no surface, rays pass (Penumbra has no media for it to bound)
+      if (s.area_light >= 0) throw Error(s.loc, "an area light on a shape with material 'interface' is not supported");
+      continue;
+    }
     if (s.type == "trianglemesh" || s.type == "plymesh") {
       add_mesh(s, load_mesh(s), material_of(s));
     } else if (s.type == "gltf") {
@@ -277,7 +287,8 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         out.structures_built.push_back(name);
   };
   for (auto& l : out.lights) collect(*l);
-  for (auto& m : out.bsdfs) collect(*m);
+  for (auto& m : out.bsdfs)
+    if (m) collect(*m);
   return out;
 }
 
