@@ -275,6 +275,9 @@ int camera_subpath(const Context& ctx, const Ray& ray, PathSampler& ps, Vertex* 
   cam.kind = VertexKind::Camera;
   cam.p = ray.o;
   cam.beta = Rgb(1.f);  // We cos / (pdf_pos pdf_dir) = 1 for every camera ray
+  // A camera that is a delta in direction (orthographic) scatters "specularly" into its rays: no
+  // strategy can connect to it (mis.h), as for a mirror.
+  cam.delta = !ctx.scene.camera().connectible();
   float pdf_dir;
   ctx.scene.camera().pdf_we(ray, &cam.pdf_fwd, &pdf_dir);
   return 1 + random_walk(ctx, ray, ps, Rgb(1.f), TransportMode::Radiance, path, ctx.config.max_depth + 1);

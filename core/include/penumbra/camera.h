@@ -46,6 +46,10 @@ class Camera {
   /// Chooses a lens point (u: uniform over the lens) seen from `p_ref`. Empty when the connection
   /// misses the film.
   virtual std::optional<CameraWiSample> sample_wi(const Vec3& p_ref, Vec2 u) const { return std::nullopt; }
+  /// Whether light paths can connect to the lens (We, pdf_we and sample_wi describe it). False for a
+  /// camera whose rays are a delta in direction (orthographic): bidirectional methods then treat the
+  /// lens vertex as specular (no t = 1 strategy), and a light tracer cannot render through it.
+  virtual bool connectible() const { return false; }
 };
 
 }  // namespace penumbra

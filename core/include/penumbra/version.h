@@ -10,7 +10,9 @@
 #ifndef PENUMBRA_SDK_VERSION
 // 2: PluginInfo gained the compiler identity after sdk_version.
 // 3: Object gained statistics() (a new virtual function changes every plugin class's vtable).
-#define PENUMBRA_SDK_VERSION 5
+// 5: SampleIntegrator gained save_state/load_state (checkpoints).
+// 6: Camera gained connectible() (orthographic cameras: light paths cannot connect to them).
+#define PENUMBRA_SDK_VERSION 6
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

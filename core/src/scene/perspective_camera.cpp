@@ -2,6 +2,8 @@
 
 #include <penumbra/sampling.h>
 
+#include "scene/screen_window.h"
+
 namespace penumbra {
 
 static const ParamSpec kParams[] = {
@@ -19,19 +21,9 @@ std::span<const ParamSpec> perspective_camera_params() { return kParams; }
 PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_to_world,
                                      Point2i resolution)
     : to_world_(camera_to_world), resolution_(resolution) {
-  float aspect = params.has("frameaspectratio")
-                     ? params.get_float("frameaspectratio")
-                     : static_cast<float>(resolution.x) / static_cast<float>(resolution.y);
-  if (aspect > 1.f) {
-    screen_min_ = Vec2(-aspect, -1.f), screen_max_ = Vec2(aspect, 1.f);
-  } else {
-    screen_min_ = Vec2(-1.f, -1.f / aspect), screen_max_ = Vec2(1.f, 1.f / aspect);
-  }
-  std::vector<float> sw = params.get_floats("screenwindow");
-  if (!sw.empty()) {
-    if (sw.size() != 4) throw Error(params.loc_of("screenwindow"), "screenwindow takes 4 values");
-    screen_min_ = Vec2(sw[0], sw[2]), screen_max_ = Vec2(sw[1], sw[3]);
-  }
+  ScreenWindow w = screen_window(params, resolution);
+  screen_min_ = w.min;
+  screen_max_ = w.max;
   float fov = params.get_float("fov");
   if (!(fov > 0.f && fov < 180.f))
     throw Error(params.loc_of("fov"), "fov must be in (0, 180) degrees");

@@ -20,6 +20,7 @@ class PerspectiveCamera final : public Camera {
   Rgb We(const Ray& ray, Vec2* p_raster = nullptr) const override;
   void pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) const override;
   std::optional<CameraWiSample> sample_wi(const Vec3& p_ref, Vec2 u) const override;
+  bool connectible() const override { return true; }
 
  private:
   /// Raster position of the camera-space ray (o, unit d), through the plane in focus; false when it

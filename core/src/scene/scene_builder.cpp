@@ -3,6 +3,7 @@
 
 #include "parser/ply_reader.h"
 #include "scene/gltf_loader.h"
+#include "scene/orthographic_camera.h"
 #include "scene/perspective_camera.h"
 
 #include <fmt/core.h>
@@ -149,11 +150,17 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   AovSet aov_set = aovs ? parse_aovs(aovs->strings, aovs->loc) : AovSet{};
   out.film = std::make_unique<FilmRgb>(res, PixelFilter(filter_type, desc.filter.params, desc.filter.loc), aov_set);
 
-  if (!desc.camera.type.empty() && desc.camera.type != "perspective")
+  std::unique_ptr<Camera> camera;
+  if (desc.camera.type.empty() || desc.camera.type == "perspective") {
+    desc.camera.params.validate(perspective_camera_params(), "camera 'perspective'");
+    camera = std::make_unique<PerspectiveCamera>(desc.camera.params, desc.camera.to_world, res);
+  } else if (desc.camera.type == "orthographic") {
+    desc.camera.params.validate(orthographic_camera_params(), "camera 'orthographic'");
+    camera = std::make_unique<OrthographicCamera>(desc.camera.params, desc.camera.to_world, res);
+  } else {
     throw Error(desc.camera.loc,
-                fmt::format("unsupported camera '{}'; available: perspective", desc.camera.type));
-  desc.camera.params.validate(perspective_camera_params(), "camera 'perspective'");
-  auto camera = std::make_unique<PerspectiveCamera>(desc.camera.params, desc.camera.to_world, res);
+                fmt::format("unsupported camera '{}'; available: orthographic, perspective", desc.camera.type));
+  }
 
   // Sampler and integrator plugins.
   out.sampler_name = desc.sampler.type.empty() ? kDefaultSampler : desc.sampler.type;

@@ -29,6 +29,9 @@ class LightTracingIntegrator final : public SampleIntegrator {
   }
 
   void begin_render(RenderContext& rc) override {
+    if (!rc.scene().camera().connectible())
+      throw Error("integrator 'lighttracing' connects every light vertex to the lens, and this camera cannot be "
+                  "connected to (an orthographic camera's rays are one direction per film point); use path, bdpt or sppm");
     chooser_ = std::make_unique<LightChooser>(rc.scene(), uniform_lights_);
     ctx_ = std::make_unique<Context>(Context{rc.scene(), *chooser_, config_});
   }
