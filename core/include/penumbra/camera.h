@@ -46,6 +46,13 @@ class Camera {
   /// Chooses a lens point (u: uniform over the lens) seen from `p_ref`. Empty when the connection
   /// misses the film.
   virtual std::optional<CameraWiSample> sample_wi(const Vec3& p_ref, Vec2 u) const { return std::nullopt; }
+
+  /// Approximate change of a surface point p (normal n) from one pixel to the next, for texture
+  /// filtering where no ray differentials exist (pbrt-v4's estimate: the camera's smallest
+  /// per-pixel ray spread, intersected with the tangent plane at p). Zero by default.
+  virtual void approximate_dp_dxy(const Vec3& p, const Vec3& n, Vec3* dpdx, Vec3* dpdy) const {
+    *dpdx = *dpdy = Vec3(0.f);
+  }
 };
 
 }  // namespace penumbra

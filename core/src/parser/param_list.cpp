@@ -20,7 +20,7 @@ struct TypeInfo {
   ValueKind kind;
 };
 
-constexpr std::array<TypeInfo, 14> kTypes{{
+constexpr std::array<TypeInfo, 15> kTypes{{
     {"integer", ValueKind::Integer},
     {"float", ValueKind::Number},
     {"point2", ValueKind::Number},
@@ -35,10 +35,11 @@ constexpr std::array<TypeInfo, 14> kTypes{{
     {"bool", ValueKind::Bool},
     {"string", ValueKind::String},
     {"spectrum", ValueKind::Spectrum},
+    {"texture", ValueKind::String},  // the name of a texture
 }};
 
-// pbrt-v4 types that Penumbra knowingly leaves out (no textures, no spectral rendering).
-constexpr std::array<std::string_view, 2> kUnsupportedTypes{"texture", "blackbody"};
+// pbrt-v4 types that Penumbra knowingly leaves out (no spectral rendering).
+constexpr std::array<std::string_view, 1> kUnsupportedTypes{"blackbody"};
 
 std::string suggest_type(const std::string& given) {
   std::string best;
