@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 
 namespace penumbra {
 
@@ -47,6 +48,12 @@ struct CreateContext {
   TexturedFloat float_input(const std::string& name) const;
   /// Same for colours: an "rgb"/"spectrum" value or a spectrum texture.
   TexturedRgb rgb_input(const std::string& name) const;
+  /// float_input() or rgb_input() by the value type T (float or Rgb).
+  template <typename T>
+  typename TextureOf<T>::Input input(const std::string& name) const {
+    if constexpr (std::is_same_v<T, float>) return float_input(name);
+    else return rgb_input(name);
+  }
 };
 
 using PluginFactory = Object* (*)(const CreateContext& ctx);

@@ -73,4 +73,19 @@ class TexturedRgb {
   const SpectrumTexture* texture_ = nullptr;
 };
 
+/// The interface and parameter type of a texture of values T (float or Rgb), for plugins that
+/// implement both kinds with one template: `class Mix : public TextureOf<T>::Texture`.
+template <typename T>
+struct TextureOf;
+template <>
+struct TextureOf<float> {
+  using Texture = FloatTexture;
+  using Input = TexturedFloat;
+};
+template <>
+struct TextureOf<Rgb> {
+  using Texture = SpectrumTexture;
+  using Input = TexturedRgb;
+};
+
 }  // namespace penumbra

@@ -100,8 +100,8 @@ void add_value(Param& p, ValueKind kind, const Token& v) {
     case ValueKind::String:
       if (v.kind != TokenKind::String)
         throw Error(v.loc,
-                    fmt::format("parameter '{}' of type 'string' needs quoted strings, got {}",
-                                p.name, describe(v)));
+                    fmt::format("parameter '{}' of type '{}' needs quoted strings, got {}",
+                                p.name, p.type, describe(v)));
       p.strings.push_back(v.text);
       return;
     case ValueKind::Spectrum:
