@@ -96,9 +96,8 @@ struct SurfaceInteraction {
   Vec3 ns;           // shading normal, in the same hemisphere as ng
   Vec2 uv;           // surface parameterisation
   // Texture lookups, filled only where the hit's material has textured parameters (otherwise zero):
-  // the parameterisation's derivatives and the footprint of a pixel at the hit, estimated from the
-  // camera (Camera::approximate_dp_dxy) and turned into (u, v) differences by least squares.
-  Vec3 dpdu{0.f}, dpdv{0.f};
+  // the footprint of a pixel at the hit, estimated from the camera (Camera::approximate_dp_dxy)
+  // and turned into (u, v) differences by least squares with the parameterisation's dp/du, dp/dv.
   Vec3 dpdx{0.f}, dpdy{0.f};
   float dudx = 0.f, dudy = 0.f, dvdx = 0.f, dvdy = 0.f;
   Vec3 wo;           // unit direction back along the incoming ray

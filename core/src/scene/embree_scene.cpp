@@ -154,17 +154,18 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
 // pbrt-v4's differentials without ray differentials: the camera estimates how far p moves per
 // pixel, and (du, dv) follow from dp = du dpdu + dv dpdv by least squares in the tangent plane.
 void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Geometry& g) const {
-  if (g.mesh) g.mesh->uv_derivatives(si.prim_id, &si.dpdu, &si.dpdv);
-  else g.sphere->uv_derivatives(si.p, &si.dpdu, &si.dpdv);
+  Vec3 dpdu, dpdv;
+  if (g.mesh) g.mesh->uv_derivatives(si.prim_id, &dpdu, &dpdv);
+  else g.sphere->uv_derivatives(si.p, &dpdu, &dpdv);
   camera_->approximate_dp_dxy(si.p, si.ng, &si.dpdx, &si.dpdy);
   si.dpdx *= footprint_scale_;
   si.dpdy *= footprint_scale_;
-  float a00 = glm::dot(si.dpdu, si.dpdu), a01 = glm::dot(si.dpdu, si.dpdv), a11 = glm::dot(si.dpdv, si.dpdv);
+  float a00 = glm::dot(dpdu, dpdu), a01 = glm::dot(dpdu, dpdv), a11 = glm::dot(dpdv, dpdv);
   float det = a00 * a11 - a01 * a01;
   float inv = det != 0.f ? 1.f / det : 0.f;
   if (!std::isfinite(inv)) inv = 0.f;
   auto solve = [&](const Vec3& d, float* du, float* dv) {
-    float b0 = glm::dot(si.dpdu, d), b1 = glm::dot(si.dpdv, d);
+    float b0 = glm::dot(dpdu, d), b1 = glm::dot(dpdv, d);
     *du = std::clamp((a11 * b0 - a01 * b1) * inv, -1e8f, 1e8f);
     *dv = std::clamp((a00 * b1 - a01 * b0) * inv, -1e8f, 1e8f);
   };
