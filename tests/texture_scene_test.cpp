@@ -231,3 +231,18 @@ TEST(TextureScene, FeatureScenesMatchPbrtV4) {
     for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(test::mean_channel(r.image, ch) / c.pbrt_mean[ch], 1.0, 0.01);
   }
 }
+
+// The real pbrt-v4 scene with a checkerboard texture (material-testball) renders unchanged at low
+// resolution, with no non-finite pixel.
+TEST(TextureScene, MaterialTestballRenders) {
+  RenderSettings s;
+  s.scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/pbrt-v4/material-testball/scene-v4.pbrt";
+  s.quiet = true;
+  s.resolution = std::make_pair(32, 18);
+  s.spp = 4;
+  s.seed = 1;
+  RenderResult r = render(s);
+  EXPECT_EQ(test::count_nonfinite(r.image), 0);
+  EXPECT_EQ(r.stats.nonfinite_samples, 0u);
+  EXPECT_GT(test::mean_channel(r.image, 0), 0.0);
+}
