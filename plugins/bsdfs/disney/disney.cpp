@@ -1,7 +1,8 @@
 // Material "disney": the Disney principled BSDF (Burley 2012, 2015) with pbrt-v3's parameters:
 // Burley diffuse with retro-reflection, sheen, anisotropic GGX specular with Disney's Fresnel,
 // GTR1 clearcoat, rough specular transmission, and for thin surfaces a flatness-blended fake
-// subsurface lobe and diffuse transmission. No subsurface scattering.
+// subsurface lobe and diffuse transmission. No subsurface scattering. `color` and every fraction
+// may be a texture (`"texture roughness" "name"`), clamped into its range at each lookup.
 //
 // | parameter            | default     | meaning                                                      |
 // |----------------------|-------------|--------------------------------------------------------------|

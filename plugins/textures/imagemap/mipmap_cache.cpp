@@ -17,7 +17,6 @@ using namespace penumbra;
 
 Encoding parse_encoding(const std::string& text, const FileLoc& loc) {
   Encoding e;
-  e.given = true;
   if (text == "sRGB") {
     e.kind = Encoding::Kind::Srgb;
     return e;

@@ -15,7 +15,6 @@ namespace imagemap {
 struct Encoding {
   enum class Kind { Srgb, Linear, Gamma } kind = Kind::Srgb;
   float gamma = 1.f;
-  bool given = false;  // false: the default (sRGB for integer files)
 };
 
 /// Parses "sRGB", "linear" or "gamma G"; throws at `loc` otherwise.
