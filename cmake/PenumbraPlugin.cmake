@@ -12,8 +12,8 @@
 # exported, so two plugins may define the same internal names without clashing.
 function(penumbra_add_plugin NAME KIND)
   cmake_parse_arguments(ARG "" "" "SOURCES;ALIASES;LIBRARIES" ${ARGN})
-  if(NOT KIND MATCHES "^(integrator|sampler|bsdf|light)$")
-    message(FATAL_ERROR "penumbra_add_plugin(${NAME} ${KIND}): KIND must be integrator, sampler, bsdf or light")
+  if(NOT KIND MATCHES "^(integrator|sampler|bsdf|light|texture)$")
+    message(FATAL_ERROR "penumbra_add_plugin(${NAME} ${KIND}): KIND must be integrator, sampler, bsdf, light or texture")
   endif()
   if(NOT ARG_SOURCES)
     message(FATAL_ERROR "penumbra_add_plugin(${NAME} ${KIND}): no SOURCES")

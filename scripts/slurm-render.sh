@@ -70,7 +70,11 @@ render_part() {
     # Requeued rather than failed, so the merge job's dependency still waits for this part (a failed
     # task would leave it DependencyNeverSatisfied). Slurm holds the job briefly before it runs again.
     if [ -n "${SLURM_JOB_ID:-}" ] && [ "${PENUMBRA_SLURM_REQUEUE:-1}" = 1 ]; then
-      scontrol requeue "$SLURM_JOB_ID" && echo "slurm-render: part $i requeued (job $SLURM_JOB_ID)" >&2
+      if scontrol requeue "$SLURM_JOB_ID"; then
+        echo "slurm-render: part $i requeued (job $SLURM_JOB_ID)" >&2
+        # Let Slurm end this run as requeued; exiting first could record it as failed.
+        sleep 120
+      fi
     fi
   fi
   return "$rc"

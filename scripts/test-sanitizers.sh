@@ -6,8 +6,11 @@
 # scripts/test.sh run before; without them, every test). Instrumented code runs 5-10 times slower,
 # and the long statistical renders would take most of an hour under it; on the last measurement the
 # rule kept 521 of 567 tests (116 of 357 s of Release test time). Always left out: the time-budget
-# tests (they measure wall-clock overrun, which instrumentation changes) and the farm test (the same
-# programs run in the plain suite; its daemons are not ours).
+# tests (they measure wall-clock overrun, which instrumentation changes), the farm test (the same
+# programs run in the plain suite; its daemons are not ours) and the plugin-export test (at -O1 the
+# compiler leaves inline library functions out of line, which it then counts as exports).
+# Measured here (machine shared with other builds): 363 of 364 selected tests passed in 634 s, the
+# one failure that export test, no sanitizer report.
 #   scripts/test-sanitizers.sh [ctest options...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,4 +37,4 @@ if [ -f "$costs" ]; then
   [ -n "$regex" ] && select=(-R "$regex")
   echo "test-sanitizers: $(awk -v t="${PENUMBRA_ASAN_MAX_SECONDS:-1}" 'NF == 3 && $3 + 0 <= t' "$costs" | wc -l) tests of at most ${PENUMBRA_ASAN_MAX_SECONDS:-1} s in the Release suite" >&2
 fi
-ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E "TimeBudget|Farm\." "${select[@]}" "$@"
+ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E "TimeBudget|Farm\.|Sdk\.BuiltinPluginsExportOnlyTheirEntryPoint" "${select[@]}" "$@"

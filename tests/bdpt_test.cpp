@@ -54,7 +54,7 @@ struct Density {
 };
 
 double bsdf_pdf(const Vertex& v, const Vertex& from, const Vertex& to) {
-  return v.bsdf->pdf(v.shading.to_local(toward(v, from)), v.shading.to_local(toward(v, to)), ShadingContext{v.uv});
+  return v.bsdf->pdf(v.shading.to_local(toward(v, from)), v.shading.to_local(toward(v, to)), ShadingContext{v.tex});
 }
 
 Density light_side(const Scene& scene, const LightChooser& lights, const FullPath& fp, int i) {

@@ -96,15 +96,15 @@ TEST(ParserErrors, UnknownDirectiveSuggestsTheClosestOne) {
 }
 
 TEST(ParserErrors, UnsupportedDirectiveNamesTheDocs) {
-  expect_error("WorldBegin\nTexture \"checks\" \"spectrum\" \"checkerboard\"", 2, 1,
-               "unsupported directive 'Texture' (Penumbra supports a subset of pbrt-v4: see "
+  expect_error("WorldBegin\nObjectBegin \"tree\"", 2, 1,
+               "unsupported directive 'ObjectBegin' (Penumbra supports a subset of pbrt-v4: see "
                "docs/scene-format.md)");
 }
 
 TEST(ParserErrors, EveryUnsupportedPbrtDirectiveIsNamedAsSuch) {
   for (const char* d :
        {"ActiveTransform", "Attribute", "MakeNamedMedium", "MediumInterface", "ObjectBegin",
-        "ObjectEnd", "ObjectInstance", "Texture", "TransformTimes"}) {
+        "ObjectEnd", "ObjectInstance", "TransformTimes"}) {
     SCOPED_TRACE(d);
     expect_error(fmt::format("WorldBegin\n {}", d), 2, 2,
                  fmt::format("unsupported directive '{}'", d));
@@ -191,9 +191,25 @@ TEST(ParserErrors, UnknownParameterType) {
                "unknown parameter type 'flot'; did you mean 'float'?");
 }
 
-TEST(ParserErrors, TextureParameterTypeIsNotSupported) {
-  expect_error("WorldBegin\nMaterial \"diffuse\" \"texture reflectance\" \"checks\"", 2, 20,
-               "parameter type 'texture' is not supported");
+// Texture directives: the value type, redefinition and placement are checked by the parser; names
+// are resolved when the scene is built (tests/texture_scene_test.cpp).
+TEST(ParserErrors, TextureTypeMustBeFloatOrSpectrum) {
+  expect_error("WorldBegin\nTexture \"checks\" \"color\" \"checkerboard\"", 2, 18,
+               "texture type must be \"float\" or \"spectrum\", got \"color\"");
+}
+
+TEST(ParserErrors, TextureRedefinedIsAnError) {
+  expect_error("WorldBegin\nTexture \"t\" \"float\" \"constant\"\nTexture \"t\" \"float\" \"constant\"", 3, 9,
+               "float texture 't' redefined (first defined at scene.pbrt:2:1)");
+}
+
+TEST(ParserErrors, TextureBeforeWorldBegin) {
+  expect_error("Texture \"t\" \"float\" \"constant\"", 1, 1, "Texture must come after WorldBegin");
+}
+
+TEST(ParserErrors, TextureParameterTakesAName) {
+  expect_error("WorldBegin\nMaterial \"diffuse\" \"texture reflectance\" 0.5", 2, 42,
+               "parameter 'reflectance' of type 'texture' needs quoted strings");
 }
 
 TEST(ParserErrors, BadParameterDeclaration) {

@@ -52,7 +52,7 @@ Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMo
   v.ng = si.ng;
   v.ns = si.ns;
   v.shading = si.shading;
-  v.uv = si.uv;
+  v.tex = si.texture_context();
   v.wo = si.wo;
   v.bsdf = si.bsdf;
   v.light = si.area_light;
@@ -65,7 +65,7 @@ Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMo
 // given the local directions towards a and b: one pair of directions for both BSDF densities.
 void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vec3& wa, const Vertex& b, const Vec3& wb,
                       float* to_b, float* to_a) {
-  ShadingContext sc{cur.uv, cur.mode};
+  ShadingContext sc{cur.tex, cur.mode};
   *to_b = convert_density(cur.bsdf->pdf(wa, wb, sc), cur, b);
   *to_a = convert_density(cur.bsdf->pdf(wb, wa, sc), cur, a);
 }
@@ -123,7 +123,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     float u_rr = ps.get_1d();
 
     const Bsdf& bsdf = *v.bsdf;
-    ShadingContext sctx{v.uv, mode};
+    ShadingContext sctx{v.tex, mode};
     Vec3 wo = v.shading.to_local(v.wo);
     std::optional<BsdfSample> bs = bsdf.flags() ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
     if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
@@ -179,7 +179,7 @@ Rgb Vertex::f(const Vertex& next) const {
   if (kind != VertexKind::Surface) return Rgb(0.f);
   Vec3 wi = direction_to(*this, next);
   if (leaks(*this, wo, wi)) return Rgb(0.f);
-  Rgb value = bsdf->f(shading.to_local(wo), shading.to_local(wi), ShadingContext{uv, mode});
+  Rgb value = bsdf->f(shading.to_local(wo), shading.to_local(wi), ShadingContext{tex, mode});
   if (mode == TransportMode::Importance) value *= shading_correction(*this, wo, wi);
   return value;
 }
@@ -226,7 +226,7 @@ float pdf_area(const Context& ctx, const Vertex* prev, const Vertex& cur, const 
     return convert_density(pdf_dir, cur, next);
   }
   Vec3 wp = direction_to(cur, *prev);
-  float pdf_dir = cur.bsdf->pdf(cur.shading.to_local(wp), cur.shading.to_local(wn), ShadingContext{cur.uv, cur.mode});
+  float pdf_dir = cur.bsdf->pdf(cur.shading.to_local(wp), cur.shading.to_local(wn), ShadingContext{cur.tex, cur.mode});
   return convert_density(pdf_dir, cur, next);
 }
 
@@ -260,7 +260,7 @@ double next_event_ratio(const Vertex& x0, const Vertex& x1) {
   hit.p = x0.p;
   hit.ng = x0.ng;
   hit.ns = x0.ng;
-  hit.uv = x0.uv;
+  hit.uv = x0.tex.uv;
   float pdf_solid_angle = x0.light->pdf_li(LightSampleContext{x1.p, x1.ng}, wi, hit);
   float pdf_pos, pdf_dir;
   x0.light->pdf_le(Ray{x0.p, -wi}, x0.ng, &pdf_pos, &pdf_dir);
@@ -428,7 +428,7 @@ double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex*
 // Vertex::f() towards world direction wi (local wi_local), wi = direction_to(v, next).
 Rgb surface_f(const Vertex& v, const Vec3& wi, const Vec3& wi_local) {
   if (leaks(v, v.wo, wi)) return Rgb(0.f);
-  Rgb value = v.bsdf->f(v.shading.to_local(v.wo), wi_local, ShadingContext{v.uv, v.mode});
+  Rgb value = v.bsdf->f(v.shading.to_local(v.wo), wi_local, ShadingContext{v.tex, v.mode});
   if (v.mode == TransportMode::Importance) value *= shading_correction(v, v.wo, wi);
   return value;
 }
@@ -521,7 +521,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       return c;
     }
     if (!pt.light) return c;
-    c.L = pt.beta * pt.light->L(pt.p, pt.ng, pt.uv, direction_to(pt, camera[t - 2]));
+    c.L = pt.beta * pt.light->L(pt.p, pt.ng, pt.tex.uv, direction_to(pt, camera[t - 2]));
     finish(nullptr, nullptr);
     return c;
   }
@@ -546,7 +546,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     if (qs.kind == VertexKind::Surface)
       c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
     else  // a point on an area light seen directly (light tracing's s = 1)
-      c.L = qs.beta * qs.light->L(qs.p, qs.ng, qs.uv, cw->wi) * std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
+      c.L = qs.beta * qs.light->L(qs.p, qs.ng, qs.tex.uv, cw->wi) * std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
     if (is_black(c.L) || scene.occluded(shadow_ray(qs, cam.p, Vec3(0.f)))) {
       c.L = Rgb(0.f);
       return c;

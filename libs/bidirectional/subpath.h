@@ -57,7 +57,7 @@ struct Vertex {
   Vec3 p_error{0.f};      // bound on the floating-point error of p (surfaces), for ray offsets
   Vec3 ng{0.f}, ns{0.f};  // zero for points not on a surface (point lights, the lens)
   Frame shading;
-  Vec2 uv{0.f};
+  TextureEvalContext tex;  // surfaces: where textured materials are evaluated (tex.uv: the uv)
   Vec3 wo{0.f};           // surfaces: unit direction towards the previous vertex of the subpath
   Vec3 w_light{0.f};      // vertices at infinity (environment, distant light): direction light travels
   const Bsdf* bsdf = nullptr;

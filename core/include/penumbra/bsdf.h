@@ -1,11 +1,14 @@
-// Materials as BSDF plugins. A Bsdf is created once per material directive with constant
-// parameters; it evaluates and samples scattering in the local shading frame of a hit (normal +z).
-// Directions point away from the surface. f() excludes the cosine factor.
+// Materials as BSDF plugins. A Bsdf is created once per material directive; it evaluates and
+// samples scattering in the local shading frame of a hit (normal +z). Directions point away from
+// the surface. f() excludes the cosine factor. Textured parameters (TexturedFloat, TexturedRgb from
+// texture.h) are evaluated in each call at the ShadingContext's TextureEvalContext; constant ones
+// are read once at creation.
 #pragma once
 
 #include <penumbra/color.h>
 #include <penumbra/math.h>
 #include <penumbra/object.h>
+#include <penumbra/texture.h>
 
 #include <cstdint>
 #include <optional>
@@ -24,9 +27,10 @@ enum BsdfFlags : uint32_t {
   BsdfSpecular = 1u << 4,
 };
 
-/// Where the BSDF is evaluated, for future textured parameters.
+/// Where the BSDF is evaluated: the texture lookup context of the hit and the transport mode.
+/// Built from a hit as ShadingContext{si.texture_context(), mode}.
 struct ShadingContext {
-  Vec2 uv{0.f};
+  TextureEvalContext tex;
   TransportMode mode = TransportMode::Radiance;
 };
 

@@ -50,6 +50,13 @@ class Camera {
   /// camera whose rays are a delta in direction (orthographic): bidirectional methods then treat the
   /// lens vertex as specular (no t = 1 strategy), and a light tracer cannot render through it.
   virtual bool connectible() const { return false; }
+
+  /// Approximate change of a surface point p (normal n) from one pixel to the next, for texture
+  /// filtering where no ray differentials exist (pbrt-v4's estimate: the camera's smallest
+  /// per-pixel ray spread, intersected with the tangent plane at p). Zero by default.
+  virtual void approximate_dp_dxy(const Vec3& p, const Vec3& n, Vec3* dpdx, Vec3* dpdy) const {
+    *dpdx = *dpdy = Vec3(0.f);
+  }
 };
 
 }  // namespace penumbra

@@ -23,8 +23,16 @@ void write_image(const std::string& path, const ImageRgb& img,
                  const std::vector<std::pair<std::string, std::string>>& metadata = {},
                  const std::string& view = "");
 
+/// How a file stores its pixels, for readers that decode them (a colour encoding such as sRGB
+/// applies to integer formats only).
+struct ImageFileInfo {
+  bool integer = false;  // 8- or 16-bit integers (PNG, JPEG, 8-bit TIFF ...), read as value / max
+  int channels = 0;
+};
+
 /// Reads any format OpenImageIO knows as float RGB (grey images are replicated, extra channels
-/// dropped). Values are returned as stored: 8-bit files are not linearised.
-ImageRgb read_image(const std::string& path);
+/// dropped). Values are returned as stored: 8-bit files are not linearised. `info`, if given,
+/// receives how the file stores them.
+ImageRgb read_image(const std::string& path, ImageFileInfo* info = nullptr);
 
 }  // namespace penumbra

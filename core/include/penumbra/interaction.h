@@ -9,6 +9,7 @@
 
 #include <penumbra/color.h>
 #include <penumbra/math.h>
+#include <penumbra/texture.h>
 
 #include <cmath>
 
@@ -94,12 +95,21 @@ struct SurfaceInteraction {
   Vec3 ng;           // geometric normal, oriented as the shape defines its outside
   Vec3 ns;           // shading normal, in the same hemisphere as ng
   Vec2 uv;           // surface parameterisation
+  // Texture lookups, filled only where the hit's material has textured parameters (otherwise zero):
+  // the footprint of a pixel at the hit, estimated from the camera (Camera::approximate_dp_dxy)
+  // and turned into (u, v) differences by least squares with the parameterisation's dp/du, dp/dv.
+  Vec3 dpdx{0.f}, dpdy{0.f};
+  float dudx = 0.f, dudy = 0.f, dvdx = 0.f, dvdy = 0.f;
   Vec3 wo;           // unit direction back along the incoming ray
   float t = 0.f;     // ray parameter of the hit
   Frame shading;     // frame around ns: BSDFs work in it
   const Bsdf* bsdf = nullptr;         // material at the hit (never null for scene geometry)
   const Light* area_light = nullptr;  // emitter on this primitive, if any
   uint32_t shape_id = 0, prim_id = 0;
+
+  TextureEvalContext texture_context() const {
+    return TextureEvalContext{p, ng, uv, dpdx, dpdy, dudx, dudy, dvdx, dvdy};
+  }
 
   Ray spawn_ray(const Vec3& d) const { return Ray{offset_ray_origin(p, p_error, ng, d), d, Infinity}; }
   /// Shadow ray to a point p1 (normal n1, zero if none) whose error is estimated from its magnitude.

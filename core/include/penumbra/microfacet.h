@@ -14,6 +14,8 @@
 #include <penumbra/color.h>
 #include <penumbra/math.h>
 #include <penumbra/params.h>
+#include <penumbra/plugin.h>
+#include <penumbra/texture.h>
 
 #include <algorithm>
 #include <complex>
@@ -208,6 +210,32 @@ inline Vec2 microfacet_alphas(const ParamSet& p) {
   if (p.get_bool("remaproughness", true))
     r = Vec2(TrowbridgeReitz::roughness_to_alpha(r.x), TrowbridgeReitz::roughness_to_alpha(r.y));
   return r;
+}
+
+/// The same roughness parameters where any may be a float texture (`"texture roughness" "name"`):
+/// constants are checked as microfacet_alphas() does; textured values are clamped at 0 per lookup.
+struct MicrofacetRoughness {
+  TexturedFloat u, v;
+  bool remap = true;
+
+  bool is_constant() const { return u.is_constant() && v.is_constant(); }
+  /// The distribution at a hit.
+  TrowbridgeReitz at(const TextureEvalContext& ctx) const {
+    Vec2 r(std::max(0.f, u.evaluate(ctx)), std::max(0.f, v.evaluate(ctx)));
+    if (remap) r = Vec2(TrowbridgeReitz::roughness_to_alpha(r.x), TrowbridgeReitz::roughness_to_alpha(r.y));
+    return TrowbridgeReitz(r.x, r.y);
+  }
+};
+
+inline MicrofacetRoughness microfacet_roughness(const CreateContext& ctx) {
+  const ParamSet& p = ctx.params;
+  microfacet_alphas(p);  // checks the constants
+  MicrofacetRoughness m;
+  TexturedFloat roughness = ctx.float_input("roughness");
+  m.u = p.has("uroughness") ? ctx.float_input("uroughness") : roughness;
+  m.v = p.has("vroughness") ? ctx.float_input("vroughness") : roughness;
+  m.remap = p.get_bool("remaproughness", true);
+  return m;
 }
 
 }  // namespace penumbra

@@ -14,18 +14,22 @@
 #include <penumbra/object.h>
 #include <penumbra/params.h>
 #include <penumbra/shape.h>
+#include <penumbra/texture.h>
 #include <penumbra/version.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 
 namespace penumbra {
 
-enum class PluginKind : uint32_t { Integrator = 0, Sampler = 1, Bsdf = 2, Light = 3 };
+enum class PluginKind : uint32_t { Integrator = 0, Sampler = 1, Bsdf = 2, Light = 3, Texture = 4 };
 
-/// "integrator", "sampler", "bsdf" or "light".
+/// "integrator", "sampler", "bsdf", "light" or "texture".
 const char* plugin_kind_name(PluginKind kind);
+
+class TextureTable;  // the scene's named textures (the core fills it; factories read it through inputs)
 
 /// Everything a factory gets. Parameters have been validated against the plugin's table.
 struct CreateContext {
@@ -35,6 +39,21 @@ struct CreateContext {
   Mat4 to_world{1.f};             // transform in effect at the directive (lights)
   const Shape* shape = nullptr;   // area lights: the primitive they are attached to
   bool reverse_orientation = false;
+  const TextureTable* textures = nullptr;  // named textures defined so far (materials, textures)
+  bool spectrum_texture = false;  // texture plugins: the directive asked for "spectrum" (else "float")
+
+  /// A texturable parameter: the named texture for `"texture NAME" "tex"`, else the float value
+  /// (or the table's default). An undefined texture, or a spectrum texture where a float one is
+  /// needed, is an error at the parameter.
+  TexturedFloat float_input(const std::string& name) const;
+  /// Same for colours: an "rgb"/"spectrum" value or a spectrum texture.
+  TexturedRgb rgb_input(const std::string& name) const;
+  /// float_input() or rgb_input() by the value type T (float or Rgb).
+  template <typename T>
+  typename TextureOf<T>::Input input(const std::string& name) const {
+    if constexpr (std::is_same_v<T, float>) return float_input(name);
+    else return rgb_input(name);
+  }
 };
 
 using PluginFactory = Object* (*)(const CreateContext& ctx);

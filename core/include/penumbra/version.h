@@ -10,9 +10,12 @@
 #ifndef PENUMBRA_SDK_VERSION
 // 2: PluginInfo gained the compiler identity after sdk_version.
 // 3: Object gained statistics() (a new virtual function changes every plugin class's vtable).
-// 5: SampleIntegrator gained save_state/load_state (checkpoints).
+// 4: the core render loop (SampleIntegrator with pass hooks, PixelIntegrator on top).
+// 5: SampleIntegrator::save_state/load_state (checkpoints).
 // 6: Camera gained connectible() (orthographic cameras: light paths cannot connect to them).
-#define PENUMBRA_SDK_VERSION 6
+// 7: texture plugins (PluginKind::Texture, texture.h); ShadingContext carries a TextureEvalContext;
+//    SurfaceInteraction gained a pixel footprint; Camera::approximate_dp_dxy().
+#define PENUMBRA_SDK_VERSION 7
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

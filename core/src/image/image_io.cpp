@@ -189,7 +189,7 @@ void write_image(const std::string& path, const ImageRgb& img,
   }
 }
 
-ImageRgb read_image(const std::string& path) {
+ImageRgb read_image(const std::string& path, ImageFileInfo* info) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
@@ -201,6 +201,10 @@ ImageRgb read_image(const std::string& path) {
     throw Error(fmt::format("cannot read image '{}': {}x{} pixels with {} channels is outside what Penumbra reads "
                             "(at most {:.0f} pixels)",
                             path, spec.width, spec.height, channels, kMaxPixels));
+  if (info) {
+    info->integer = !spec.format.is_floating_point();
+    info->channels = channels;
+  }
   std::vector<float> all(size_t(spec.width) * spec.height * channels);
   if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data()))
     throw Error(fmt::format("cannot read image '{}': {}", path, in->geterror()));

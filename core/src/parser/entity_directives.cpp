@@ -123,6 +123,26 @@ void SceneParser::shape(const Token& d) {
   desc_.shapes.push_back(std::move(s));
 }
 
+// pbrt-v4: textures are named globally (not scoped by attributes); float and spectrum textures
+// have separate names, and defining one twice is an error.
+void SceneParser::texture(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "texture name");
+  Token kind = expect_string(d, "texture type (\"float\" or \"spectrum\")");
+  if (kind.text != "float" && kind.text != "spectrum")
+    throw Error(kind.loc, fmt::format("texture type must be \"float\" or \"spectrum\", got \"{}\"", kind.text));
+  bool spectrum = kind.text == "spectrum";
+  for (const auto& t : desc_.textures)
+    if (t.name == name.text && t.spectrum == spectrum)
+      throw Error(name.loc, fmt::format("{} texture '{}' redefined (first defined at {})", kind.text,
+                                        name.text, t.loc.str()));
+  TextureEntity t;
+  static_cast<SceneEntity&>(t) = make_entity(d, "texture class");
+  t.name = name.text;
+  t.spectrum = spectrum;
+  desc_.textures.push_back(std::move(t));
+}
+
 void SceneParser::reverse_orientation(const Token&) {
   state_.reverse_orientation = !state_.reverse_orientation;
 }

@@ -20,7 +20,7 @@ struct TypeInfo {
   ValueKind kind;
 };
 
-constexpr std::array<TypeInfo, 15> kTypes{{
+constexpr std::array<TypeInfo, 16> kTypes{{
     {"integer", ValueKind::Integer},
     {"float", ValueKind::Number},
     {"point2", ValueKind::Number},
@@ -36,10 +36,11 @@ constexpr std::array<TypeInfo, 15> kTypes{{
     {"string", ValueKind::String},
     {"spectrum", ValueKind::Spectrum},
     {"blackbody", ValueKind::Number},
+    {"texture", ValueKind::String},  // the name of a texture
 }};
 
-// pbrt-v4 types that Penumbra knowingly leaves out.
-constexpr std::array<std::string_view, 1> kUnsupportedTypes{"texture"};
+// pbrt-v4 types that Penumbra knowingly leaves out: none at the moment (kept for the error path).
+constexpr std::array<std::string_view, 0> kUnsupportedTypes{};
 
 std::string suggest_type(const std::string& given) {
   std::string best;
@@ -100,8 +101,8 @@ void add_value(Param& p, ValueKind kind, const Token& v) {
     case ValueKind::String:
       if (v.kind != TokenKind::String)
         throw Error(v.loc,
-                    fmt::format("parameter '{}' of type 'string' needs quoted strings, got {}",
-                                p.name, describe(v)));
+                    fmt::format("parameter '{}' of type '{}' needs quoted strings, got {}",
+                                p.name, p.type, describe(v)));
       p.strings.push_back(v.text);
       return;
     case ValueKind::Spectrum:

@@ -18,7 +18,7 @@ namespace {
 // "unknown directive".
 const std::set<std::string> kUnsupported = {
     "ActiveTransform", "Attribute",      "MakeNamedMedium", "MediumInterface", "ObjectBegin",
-    "ObjectEnd",       "ObjectInstance", "Texture",         "TransformTimes",
+    "ObjectEnd",       "ObjectInstance", "TransformTimes",
 };
 
 bool read_whole_file(const fs::path& path, std::string& text) {
@@ -75,6 +75,7 @@ const std::map<std::string, SceneParser::Handler>& SceneParser::handlers() {
       {"Sampler", &SceneParser::sampler},
       {"Scale", &SceneParser::scale},
       {"Shape", &SceneParser::shape},
+      {"Texture", &SceneParser::texture},
       {"Transform", &SceneParser::transform},
       {"TransformBegin", &SceneParser::transform_begin},
       {"TransformEnd", &SceneParser::transform_end},

@@ -30,6 +30,12 @@ struct ShapeEntity : SceneEntity {
   int area_light = -1;          // index into SceneDescription::area_lights, or -1
 };
 
+/// `Texture "name" "float"|"spectrum" "class" ...`: type is the class (the plugin's name).
+struct TextureEntity : SceneEntity {
+  std::string name;
+  bool spectrum = false;  // "spectrum" (else "float")
+};
+
 struct SceneDescription {
   std::string filename;  // the top-level scene file
   SceneEntity camera;    // to_world is the camera-to-world transform (inverse of the CTM at Camera)
@@ -37,6 +43,7 @@ struct SceneDescription {
   SceneEntity filter;
   SceneEntity sampler;
   SceneEntity integrator;
+  std::vector<TextureEntity> textures;            // in file order
   std::vector<SceneEntity> materials;             // Material and MakeNamedMaterial, in file order
   std::map<std::string, int> named_materials;     // name -> index into materials
   std::vector<SceneEntity> lights;                // LightSource

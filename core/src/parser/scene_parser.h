@@ -86,6 +86,7 @@ class SceneParser {
   void area_light_source(const Token& d);
   void light_source(const Token& d);
   void shape(const Token& d);
+  void texture(const Token& d);
   void reverse_orientation(const Token& d);
   void accelerator(const Token& d);
   void color_space(const Token& d);

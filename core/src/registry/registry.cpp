@@ -19,6 +19,7 @@ const char* plugin_kind_name(PluginKind kind) {
     case PluginKind::Sampler: return "sampler";
     case PluginKind::Bsdf: return "bsdf";
     case PluginKind::Light: return "light";
+    case PluginKind::Texture: return "texture";
   }
   return "unknown";
 }
@@ -121,7 +122,8 @@ Object* Registry::create_object(const LoadedPlugin& plugin, ParamSet& params, Cr
   const PluginInfo& info = *plugin.info;
   params.validate({info.params, info.param_count},
                   fmt::format("{} '{}'", plugin_kind_name(info.kind), info.name));
-  CreateContext full{params, loc, ctx.scene_dir, ctx.to_world, ctx.shape, ctx.reverse_orientation};
+  CreateContext full{params,     loc,          ctx.scene_dir,    ctx.to_world, ctx.shape,
+                     ctx.reverse_orientation, ctx.textures, ctx.spectrum_texture};
   Object* obj = info.create(full);
   if (!obj) throw Error(loc, fmt::format("{} '{}' could not be created", plugin_kind_name(info.kind), info.name));
   return obj;

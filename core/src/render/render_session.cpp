@@ -395,6 +395,9 @@ RenderResult render(const RenderSettings& settings) {
   options.spp = built.sampler->samples_per_pixel();
   if (settings.time_budget > 0.0 && !settings.spp) options.spp = INT_MAX;
   if (options.spp <= 0) throw Error(desc.sampler.params.loc_of("pixelsamples"), "pixelsamples must be positive");
+  // Texture filter footprint as pbrt-v4 scales it, from the whole render's samples per pixel (the
+  // parts of a split render filter alike).
+  built.scene->set_texture_footprint_scale(std::max(0.125f, 1.f / std::sqrt(static_cast<float>(options.spp))));
   if (range.split) {
     options.spp = range.count;
     options.first_sample = range.first;

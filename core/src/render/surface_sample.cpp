@@ -15,7 +15,7 @@ SurfaceSample trace_surface_sample(const Scene& scene, const Ray& ray, Point2i p
   if (!si->bsdf || si->bsdf->flags() == 0) return out;
   Pcg32 rng(hash_ints(uint32_t(pixel.x), uint32_t(pixel.y), index), 0xa1bed0ull);
   Vec3 wo = si->shading.to_local(si->wo);
-  ShadingContext ctx{si->uv, TransportMode::Radiance};
+  ShadingContext ctx{si->texture_context(), TransportMode::Radiance};
   float uc = rng.next_float();
   Vec2 u(rng.next_float(), rng.next_float());
   std::optional<BsdfSample> bs = si->bsdf->sample_f(wo, uc, u, ctx);

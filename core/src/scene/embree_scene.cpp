@@ -26,7 +26,7 @@ EmbreeScene::~EmbreeScene() {
 }
 
 void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
-                           std::vector<const Light*> lights) {
+                           std::vector<const Light*> lights, bool textured) {
   mesh->finish();
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
@@ -46,11 +46,11 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
   unsigned id = rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);
   if (geometries_.size() <= id) geometries_.resize(id + 1);
-  geometries_[id] = Geometry{mesh.get(), nullptr, bsdf, std::move(lights)};
+  geometries_[id] = Geometry{mesh.get(), nullptr, bsdf, std::move(lights), textured};
   meshes_.push_back(std::move(mesh));
 }
 
-void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light) {
+void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_SPHERE_POINT);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                         RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
@@ -64,7 +64,7 @@ void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, c
   if (geometries_.size() <= id) geometries_.resize(id + 1);
   std::vector<const Light*> lights;
   if (light) lights.push_back(light);
-  geometries_[id] = Geometry{nullptr, sphere.get(), bsdf, std::move(lights)};
+  geometries_[id] = Geometry{nullptr, sphere.get(), bsdf, std::move(lights), textured};
   spheres_.push_back(std::move(sphere));
 }
 
@@ -147,7 +147,30 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
     si.uv = g.sphere->uv_at(si.p);
   }
   si.shading = Frame(si.ns);
+  if (g.textured) add_texture_footprint(si, g);
   return si;
+}
+
+// pbrt-v4's differentials without ray differentials: the camera estimates how far p moves per
+// pixel, and (du, dv) follow from dp = du dpdu + dv dpdv by least squares in the tangent plane.
+void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Geometry& g) const {
+  Vec3 dpdu, dpdv;
+  if (g.mesh) g.mesh->uv_derivatives(si.prim_id, &dpdu, &dpdv);
+  else g.sphere->uv_derivatives(si.p, &dpdu, &dpdv);
+  camera_->approximate_dp_dxy(si.p, si.ng, &si.dpdx, &si.dpdy);
+  si.dpdx *= footprint_scale_;
+  si.dpdy *= footprint_scale_;
+  float a00 = glm::dot(dpdu, dpdu), a01 = glm::dot(dpdu, dpdv), a11 = glm::dot(dpdv, dpdv);
+  float det = a00 * a11 - a01 * a01;
+  float inv = det != 0.f ? 1.f / det : 0.f;
+  if (!std::isfinite(inv)) inv = 0.f;
+  auto solve = [&](const Vec3& d, float* du, float* dv) {
+    float b0 = glm::dot(dpdu, d), b1 = glm::dot(dpdv, d);
+    *du = std::clamp((a11 * b0 - a01 * b1) * inv, -1e8f, 1e8f);
+    *dv = std::clamp((a00 * b1 - a01 * b0) * inv, -1e8f, 1e8f);
+  };
+  solve(si.dpdx, &si.dudx, &si.dvdx);
+  solve(si.dpdy, &si.dudy, &si.dvdy);
 }
 
 bool EmbreeScene::occluded(const Ray& ray) const {

@@ -23,9 +23,14 @@ class EmbreeScene final : public Scene {
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 
-  /// Adds a mesh; `lights` is empty or holds one area light per triangle.
-  void add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf, std::vector<const Light*> lights);
-  void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light);
+  /// Adds a mesh; `lights` is empty or holds one area light per triangle. Hits on geometry whose
+  /// material is `textured` get uv derivatives and a pixel footprint (SurfaceInteraction::dpdx ...).
+  void add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf, std::vector<const Light*> lights,
+                bool textured = false);
+  void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured = false);
+  /// Multiplies the texture footprint: pbrt-v4's max(1/8, 1/sqrt(spp)), since many samples per pixel
+  /// already average what a wider filter would. 1 until set.
+  void set_texture_footprint_scale(float s) { footprint_scale_ = s; }
   /// Meshes and spheres kept for area lights to reference before commit().
   const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
 
@@ -54,7 +59,9 @@ class EmbreeScene final : public Scene {
     const Sphere* sphere = nullptr;
     const Bsdf* bsdf = nullptr;
     std::vector<const Light*> lights;    // per primitive, or empty
+    bool textured = false;
   };
+  void add_texture_footprint(SurfaceInteraction& si, const Geometry& g) const;
 
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
@@ -66,6 +73,7 @@ class EmbreeScene final : public Scene {
   Distribution1D light_distribution_;  // over lights_, proportional to luminance of power
   std::unique_ptr<Camera> camera_;
   Bounds3 bounds_;
+  float footprint_scale_ = 1.f;
 };
 
 }  // namespace penumbra

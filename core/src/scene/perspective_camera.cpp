@@ -39,6 +39,36 @@ PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_
   Vec2 extent = (screen_max_ - screen_min_) * tan_half_fov_;
   film_area_ = std::abs(extent.x * extent.y);
   lens_area_ = lens_radius_ > 0.f ? Pi * lens_radius_ * lens_radius_ : 1.f;
+  pixel_spread_ = Vec2(std::abs(extent.x) / resolution.x, std::abs(extent.y) / resolution.y);
+}
+
+// pbrt-v4's estimate: rotate camera space so that p lies on +z, offset the central ray's direction
+// by one pixel's spread (the smallest over the image, which the centre has) and intersect the two
+// offset rays with p's tangent plane. A thin lens is treated as its pinhole (its rays through one
+// film point meet in the plane of focus, not at p).
+void PerspectiveCamera::approximate_dp_dxy(const Vec3& p, const Vec3& n, Vec3* dpdx, Vec3* dpdy) const {
+  *dpdx = *dpdy = Vec3(0.f);
+  Vec3 pc = Vec3(from_world_ * Vec4(p, 1.f));
+  Vec3 nc = glm::transpose(glm::mat3(to_world_)) * n;  // normals: inverse transpose of camera-from-world
+  float dist = glm::length(pc);
+  if (!(dist > 0.f)) return;
+  Frame down_z(pc / dist);  // down_z.n: the direction to p
+  Vec3 nz = down_z.to_local(nc);
+  if (nz.z == 0.f) return;
+  // Tangent plane: dot(nz, x) = nz.z * dist. Rays from the origin along (spread, 0, 1) and (0, spread, 1).
+  auto hit = [&](const Vec3& d) -> Vec3 {
+    float denom = glm::dot(nz, d);
+    if (std::abs(denom) < 1e-6f) return Vec3(0.f);
+    return d * (nz.z * dist / denom) - Vec3(0.f, 0.f, dist);
+  };
+  // The frame's s and t axes are arbitrary around the direction to p; the spreads along camera x
+  // and y are carried into the rotated frame so that dpdx follows the image's x axis.
+  Vec3 ex = down_z.to_local(Vec3(1.f, 0.f, 0.f)), ey = down_z.to_local(Vec3(0.f, 1.f, 0.f));
+  Vec3 hx = hit(Vec3(0.f, 0.f, 1.f) + pixel_spread_.x * ex);
+  Vec3 hy = hit(Vec3(0.f, 0.f, 1.f) - pixel_spread_.y * ey);  // raster y grows downwards
+  Vec3 wx = down_z.to_world(hx), wy = down_z.to_world(hy);
+  *dpdx = Vec3(to_world_ * Vec4(wx, 0.f));
+  *dpdy = Vec3(to_world_ * Vec4(wy, 0.f));
 }
 
 std::optional<Ray> PerspectiveCamera::generate_ray(const CameraSample& s) const {

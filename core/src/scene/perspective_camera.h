@@ -21,6 +21,7 @@ class PerspectiveCamera final : public Camera {
   void pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) const override;
   std::optional<CameraWiSample> sample_wi(const Vec3& p_ref, Vec2 u) const override;
   bool connectible() const override { return true; }
+  void approximate_dp_dxy(const Vec3& p, const Vec3& n, Vec3* dpdx, Vec3* dpdy) const override;
 
  private:
   /// Raster position of the camera-space ray (o, unit d), through the plane in focus; false when it
@@ -34,6 +35,7 @@ class PerspectiveCamera final : public Camera {
   float lens_radius_, focal_distance_;
   float film_area_ = 1.f;  // area of the film's image on the z = 1 plane of camera space
   float lens_area_ = 1.f;  // 1 for a pinhole, so that its position density is a unit delta
+  Vec2 pixel_spread_{0.f};  // camera-space size of one pixel on the z = 1 plane (x and y)
 };
 
 std::span<const ParamSpec> perspective_camera_params();

@@ -127,6 +127,34 @@ std::unique_ptr<Sphere> load_sphere(ShapeEntity& e) {
   return std::make_unique<Sphere>(m, r, e.reverse_orientation != swaps_handedness(m));
 }
 
+bool uses_textures(const ParamSet& params) {
+  for (const auto& p : params.params())
+    if (p.type == "texture") return true;
+  return false;
+}
+
+// Every texture is created (pbrt-v4 does the same), each from its own plugin; the table lets later
+// textures and the materials find them by name.
+void build_textures(SceneDescription& desc, Registry& registry, BuiltScene& out) {
+  for (const auto& t : desc.textures) out.texture_table.declare(t.name, t.spectrum, t.loc);
+  for (auto& t : desc.textures) {
+    CreateContext ctx{t.params, {}, t.base_dir, t.to_world};
+    ctx.textures = &out.texture_table;
+    ctx.spectrum_texture = t.spectrum;
+    std::unique_ptr<Object> obj = registry.create<Object>(PluginKind::Texture, t.type, t.params, ctx, t.loc);
+    if (t.spectrum) {
+      auto* tex = dynamic_cast<const SpectrumTexture*>(obj.get());
+      if (!tex) throw Error(t.loc, fmt::format("texture '{}' did not create a spectrum texture", t.type));
+      out.texture_table.add(t.name, tex);
+    } else {
+      auto* tex = dynamic_cast<const FloatTexture*>(obj.get());
+      if (!tex) throw Error(t.loc, fmt::format("texture '{}' did not create a float texture", t.type));
+      out.texture_table.add(t.name, tex);
+    }
+    out.textures.push_back(std::move(obj));
+  }
+}
+
 }  // namespace
 
 BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
@@ -172,19 +200,33 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       PluginKind::Integrator, out.integrator_name, desc.integrator.params,
       CreateContext{desc.integrator.params, {}, desc.integrator.base_dir}, desc.integrator.loc);
 
-  // Materials, in file order; the default one only if some shape needs it.
+  // Textures in file order (a texture may use those defined before it), then materials in file
+  // order; the default material only if some shape needs it.
+  build_textures(desc, registry, out);
+  std::vector<bool> material_textured;
   for (auto& m : desc.materials) {
     if (m.type.empty()) throw Error(m.loc, "material has no type");
     if (is_composite_material(m.type)) {  // "mix" and "interface": built below from the others
       out.bsdfs.push_back(nullptr);
+      material_textured.push_back(true);  // its parts may be textured: give its hits a footprint
       continue;
     }
-    out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params,
-                                              CreateContext{m.params, {}, m.base_dir}, m.loc));
+    CreateContext ctx{m.params, {}, m.base_dir};
+    ctx.textures = &out.texture_table;
+    out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params, ctx, m.loc));
+    material_textured.push_back(uses_textures(m.params));
   }
   build_composite_materials(desc, out.bsdfs);
   const Bsdf* default_bsdf = nullptr;
   ParamSet default_params;
+  auto textured = [&](const ShapeEntity& s) {
+    int i = s.material;
+    if (i < 0 && !s.material_name.empty()) {
+      auto it = desc.named_materials.find(s.material_name);
+      i = it == desc.named_materials.end() ? -1 : it->second;
+    }
+    return i >= 0 && material_textured[i];
+  };
   auto material_of = [&](const ShapeEntity& s) -> const Bsdf* {
     if (s.material >= 0) return out.bsdfs[s.material].get();
     if (!s.material_name.empty()) {
@@ -227,7 +269,8 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     return out.lights.back().get();
   };
   std::vector<std::unique_ptr<Triangle>> light_triangles;
-  auto add_mesh = [&](const ShapeEntity& s, std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf) {
+  auto add_mesh = [&](const ShapeEntity& s, std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
+                      bool is_textured) {
     std::vector<const Light*> lights;
     if (s.area_light >= 0) {
       for (uint32_t i = 0; i < mesh->triangle_count(); ++i) {
@@ -239,7 +282,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         lights.push_back(make_area_light(s, light_triangles.back().get()));
       }
     }
-    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights));
+    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured);
   };
   for (auto& s : desc.shapes) {
     if (!material_of(s)) {  // "interface": no surface, rays pass (Penumbra has no media for it to bound)
@@ -247,7 +290,8 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       continue;
     }
     if (s.type == "trianglemesh" || s.type == "plymesh") {
-      add_mesh(s, load_mesh(s), material_of(s));
+      const Bsdf* bsdf = material_of(s);
+      add_mesh(s, load_mesh(s), bsdf, textured(s));
     } else if (s.type == "gltf") {
       s.params.validate(kGltfParams, "shape 'gltf'");
       FileLoc loc = s.params.has("filename") ? s.params.loc_of("filename") : s.loc;
@@ -255,13 +299,14 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       if (file.empty()) throw Error(s.loc, "shape 'gltf' needs \"string filename\"");
       for (GltfPrimitive& g : load_gltf(resolve(s.base_dir, file), loc)) {
         const Bsdf* bsdf = g.material ? gltf_bsdf(*g.material, s.loc) : material_of(s);
-        add_mesh(s, make_mesh(s, std::move(g.P), std::move(g.indices), std::move(g.N), std::move(g.uv), loc, loc, loc), bsdf);
+        add_mesh(s, make_mesh(s, std::move(g.P), std::move(g.indices), std::move(g.N), std::move(g.uv), loc, loc, loc), bsdf,
+                 !g.material && textured(s));
       }
     } else if (s.type == "sphere") {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Sphere> sphere = load_sphere(s);
       const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get()) : nullptr;
-      out.scene->add_sphere(std::move(sphere), bsdf, light);
+      out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s));
     } else {
       throw Error(s.loc, fmt::format("unsupported shape '{}'; available: gltf, plymesh, sphere, trianglemesh", s.type));
     }

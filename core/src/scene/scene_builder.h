@@ -6,11 +6,13 @@
 #include <penumbra/integrator.h>
 #include <penumbra/light.h>
 #include <penumbra/sampler.h>
+#include <penumbra/texture.h>
 
 #include "image/film_rgb.h"
 #include "parser/scene_description.h"
 #include "registry/registry.h"
 #include "scene/embree_scene.h"
+#include "texture/texture_table.h"
 
 #include <memory>
 #include <string>
@@ -25,6 +27,8 @@ inline constexpr const char* kDefaultFilter = "gaussian";
 inline constexpr const char* kDefaultMaterial = "diffuse";
 
 struct BuiltScene {
+  std::vector<std::unique_ptr<Object>> textures;  // FloatTexture / SpectrumTexture; materials refer to them
+  TextureTable texture_table;
   std::vector<std::unique_ptr<Bsdf>> bsdfs;
   std::vector<std::unique_ptr<Light>> lights;
   std::unique_ptr<EmbreeScene> scene;  // refers to bsdfs and lights: declared after them

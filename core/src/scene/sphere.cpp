@@ -29,6 +29,24 @@ Vec2 Sphere::uv_at(const Vec3& p) const {
   return Vec2(phi * Inv2Pi, 1.f - theta * InvPi);
 }
 
+// u = phi / 2pi and v = 1 - theta / pi: dp/du = 2pi (-y, x, 0) and dp/dv = -pi dp/dtheta in object
+// space, dp/dtheta = (z cos phi, z sin phi, -r sin theta).
+void Sphere::uv_derivatives(const Vec3& p, Vec3* dpdu, Vec3* dpdv) const {
+  Vec3 q = world_to_object_rotation_ * (p - center_);
+  float rxy = std::sqrt(q.x * q.x + q.y * q.y);
+  Vec3 du(-2.f * Pi * q.y, 2.f * Pi * q.x, 0.f), dv;
+  if (rxy > 0.f) {
+    float cos_phi = q.x / rxy, sin_phi = q.y / rxy;
+    dv = -Pi * Vec3(q.z * cos_phi, q.z * sin_phi, -rxy);
+  } else {  // at a pole: any tangent
+    du = Vec3(2.f * Pi * radius_, 0.f, 0.f);
+    dv = Vec3(0.f, Pi * radius_, 0.f);
+  }
+  glm::mat3 to_world = glm::transpose(world_to_object_rotation_);
+  *dpdu = to_world * du;
+  *dpdv = to_world * dv;
+}
+
 ShapeSample Sphere::sample_area(Vec2 u) const {
   Vec3 p = center_ + radius_ * sample_uniform_sphere(u);
   return ShapeSample{p, normal_at(p), uv_at(p), 1.f / area()};

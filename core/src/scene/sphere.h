@@ -17,6 +17,8 @@ class Sphere final : public Shape {
   /// Moves a point near the surface exactly onto it (removes the error of o + t d).
   Vec3 reproject(const Vec3& p) const;
   Vec2 uv_at(const Vec3& p) const;
+  /// dp/du and dp/dv of uv_at() at a surface point (pbrt's full-sphere parameterisation).
+  void uv_derivatives(const Vec3& p, Vec3* dpdu, Vec3* dpdv) const;
 
   float area() const override { return 4.f * Pi * radius_ * radius_; }
   ShapeSample sample_area(Vec2 u) const override;

@@ -65,6 +65,25 @@ TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
   return s;
 }
 
+void TriangleMesh::uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const {
+  const uint32_t* v = &indices[3 * i];
+  Vec2 uv0(0.f, 0.f), uv1(1.f, 0.f), uv2(1.f, 1.f);  // pbrt's default parameterisation
+  if (!uv.empty()) uv0 = uv[v[0]], uv1 = uv[v[1]], uv2 = uv[v[2]];
+  // p - p2 = (u - u2) dpdu + (v - v2) dpdv for the two edges to vertex 2, solved for dpdu, dpdv.
+  Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+  Vec3 dp02 = P[v[0]] - P[v[2]], dp12 = P[v[1]] - P[v[2]];
+  float det = duv02.x * duv12.y - duv02.y * duv12.x;
+  if (std::abs(det) > 1e-12f) {
+    float inv = 1.f / det;
+    *dpdu = (duv12.y * dp02 - duv02.y * dp12) * inv;
+    *dpdv = (duv02.x * dp12 - duv12.x * dp02) * inv;
+    if (is_finite(*dpdu) && is_finite(*dpdv) && glm::dot(glm::cross(*dpdu, *dpdv), glm::cross(*dpdu, *dpdv)) > 0.f)
+      return;
+  }
+  Frame f(face_normal(i));
+  *dpdu = f.s, *dpdv = f.t;
+}
+
 Vec2 TriangleMesh::uv_at(size_t i, const Vec3& b) const {
   if (uv.empty()) return Vec2(b.y + b.z, b.z);  // pbrt's default (0,0), (1,0), (1,1)
   const uint32_t* v = &indices[3 * i];

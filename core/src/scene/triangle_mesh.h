@@ -35,6 +35,9 @@ struct TriangleMesh {
     Vec2 uv;
   };
   Surface surface(size_t i, const Vec3& b) const;
+  /// dp/du and dp/dv of triangle i (constant over it); for a degenerate uv mapping, two axes
+  /// perpendicular to the face normal.
+  void uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const;
 
  private:
   Vec3 face_normal(size_t i) const;

@@ -58,10 +58,19 @@ static std::pair<std::string, bool> spec_base(const std::string& type) {
   return {type, false};
 }
 
+// Texturable spec types: "float texture" (a float or a float texture's name), "rgb texture" (a colour
+// or a spectrum texture's name) and "texture" (texture plugins' inputs, of the directive's kind).
+static bool is_texturable(const std::string& spec) {
+  return spec == "float texture" || spec == "rgb texture" || spec == "texture";
+}
+
 // Scene-file types a spec type accepts (pbrt-v4 spellings and synonyms).
 static bool type_accepts(const std::string& spec, const std::string& given) {
   if (spec == given) return true;
   // Spectra and blackbodies reach plugins as RGB (parser/spectrum_params.cpp converts them).
+  if (spec == "float texture") return given == "float" || given == "texture";
+  if (spec == "rgb texture") return given == "rgb" || given == "spectrum" || given == "blackbody" || given == "texture";
+  if (spec == "texture") return given == "float" || given == "rgb" || given == "spectrum";
   if (spec == "rgb") return given == "spectrum" || given == "blackbody";
   if (spec == "float|spectrum")
     return given == "float" || given == "spectrum" || given == "blackbody" || given == "rgb";
@@ -73,7 +82,10 @@ static bool type_accepts(const std::string& spec, const std::string& given) {
 }
 
 static int components(const std::string& base) {
-  if (base == "rgb" || base == "point3" || base == "vector3" || base == "normal") return 3;
+  // A blackbody has been converted to RGB by the time parameters are checked.
+  if (base == "rgb" || base == "spectrum" || base == "blackbody" || base == "point3" || base == "vector3" ||
+      base == "normal")
+    return 3;
   if (base == "point2" || base == "vector2") return 2;
   return 1;
 }
@@ -121,9 +133,13 @@ void ParamSet::validate(std::span<const ParamSpec> spec, const std::string& what
                                      what, *match->doc ? ": " : "", match->doc));
     auto [base, array] = spec_base(match->type);
     if (!type_accepts(base, p.type))
-      throw Error(p.loc, fmt::format("parameter '{}' of {} must have type '{}', not '{}'", p.name,
-                                     what, base, p.type));
-    size_t n = p.count(), k = static_cast<size_t>(components(base));
+      throw Error(p.loc, fmt::format("parameter '{}' of {} must have type '{}', not '{}'", p.name, what,
+                                     base == "float texture" ? "float' or 'texture"
+                                     : base == "rgb texture" ? "rgb' or 'texture"
+                                                             : base,
+                                     p.type));
+    // A texturable parameter takes as many values as the type it was given with.
+    size_t n = p.count(), k = static_cast<size_t>(components(is_texturable(base) ? p.type : base));
     if (base == "float|spectrum" && p.type != "float") k = 3;
     if (!array && n != k)
       throw Error(p.loc, fmt::format("parameter '{}' of {} takes {} value{}, got {}", p.name, what, k,

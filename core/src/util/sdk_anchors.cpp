@@ -10,6 +10,7 @@
 #include <penumbra/sampler.h>
 #include <penumbra/scene.h>
 #include <penumbra/shape.h>
+#include <penumbra/texture.h>
 
 namespace penumbra {
 
@@ -25,6 +26,8 @@ Shape::~Shape() = default;
 Camera::~Camera() = default;
 Film::~Film() = default;
 Scene::~Scene() = default;
+FloatTexture::~FloatTexture() = default;
+SpectrumTexture::~SpectrumTexture() = default;
 
 LobeSummary Bsdf::lobe(const Vec3& wo, const ShadingContext&) const {
   LobeSummary l;

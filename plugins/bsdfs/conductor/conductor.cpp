@@ -14,6 +14,8 @@
 //
 // pbrt-v4's defaults are the measured copper spectra "metal-Cu-eta"/"metal-Cu-k"; without spectral
 // rendering we use their RGB reduction (the values pbrt-v4's own exporter writes, e.g. veach-mis).
+// Every parameter but remaproughness may be a texture (eta, k, reflectance: spectrum textures;
+// the roughnesses: float textures), as in pbrt-v4.
 // "rgb reflectance" is pbrt-v4's artist-friendly mode: eta = 1 and k = 2 sqrt(R) / sqrt(1 - R),
 // which makes the reflectance at normal incidence exactly R.
 #include <penumbra/bsdf.h>
@@ -88,13 +90,44 @@ class ConductorBsdf final : public Bsdf {
   Rgb eta_, k_;
 };
 
+// R = 1 would need k = infinity; 0.9999 is indistinguishable and keeps Fresnel finite.
+Rgb k_from_reflectance(Rgb r) {
+  r = glm::clamp(r, Rgb(0.f), Rgb(0.9999f));
+  return 2.f * glm::sqrt(r) / glm::sqrt(Rgb(1.f) - r);
+}
+
+// Textured parameters: each call evaluates them at the hit and forwards to a ConductorBsdf made on
+// the stack (the constant material keeps its code and cost). Flags are the union over roughness.
+class TexturedConductorBsdf final : public Bsdf {
+ public:
+  TexturedConductorBsdf(MicrofacetRoughness r, TexturedRgb eta, TexturedRgb k, std::optional<TexturedRgb> reflectance)
+      : r_(r), eta_(eta), k_(k), reflectance_(reflectance) {}
+  uint32_t flags() const override { return BsdfReflection | BsdfGlossy | BsdfSpecular; }
+  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).f(wo, wi, ctx); }
+  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& ctx) const override {
+    return at(ctx).sample_f(wo, uc, u, ctx);
+  }
+  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).pdf(wo, wi, ctx); }
+  LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const override { return at(ctx).lobe(wo, ctx); }
+
+ private:
+  ConductorBsdf at(const ShadingContext& ctx) const {
+    if (reflectance_) return ConductorBsdf(r_.at(ctx.tex), Rgb(1.f), k_from_reflectance(reflectance_->evaluate(ctx.tex)));
+    return ConductorBsdf(r_.at(ctx.tex), glm::max(eta_.evaluate(ctx.tex), Rgb(1e-4f)),
+                         glm::max(k_.evaluate(ctx.tex), Rgb(0.f)));
+  }
+  MicrofacetRoughness r_;
+  TexturedRgb eta_, k_;
+  std::optional<TexturedRgb> reflectance_;
+};
+
 const ParamSpec kParams[] = {
-    {"rgb", "eta", "0.200438 0.924033 1.102212", "real part of the IOR per channel (default: copper)"},
-    {"rgb", "k", "3.912949 2.452848 2.142188", "absorption coefficient per channel (default: copper)"},
-    {"rgb", "reflectance", "", "reflectance at normal incidence; replaces eta and k (eta = 1)"},
-    {"float", "roughness", "0", "isotropic microfacet roughness (0: perfect mirror)"},
-    {"float", "uroughness", "", "roughness along the shading frame's s axis (default: roughness)"},
-    {"float", "vroughness", "", "roughness along the shading frame's t axis (default: roughness)"},
+    {"rgb texture", "eta", "0.200438 0.924033 1.102212", "real part of the IOR per channel (default: copper)"},
+    {"rgb texture", "k", "3.912949 2.452848 2.142188", "absorption coefficient per channel (default: copper)"},
+    {"rgb texture", "reflectance", "", "reflectance at normal incidence; replaces eta and k (eta = 1)"},
+    {"float texture", "roughness", "0", "isotropic microfacet roughness (0: perfect mirror)"},
+    {"float texture", "uroughness", "", "roughness along the shading frame's s axis (default: roughness)"},
+    {"float texture", "vroughness", "", "roughness along the shading frame's t axis (default: roughness)"},
     {"bool", "remaproughness", "true", "alpha = sqrt(roughness) if true, else alpha = roughness"},
     {"unsupported", "displacement", "", "displacement is not supported"},
     {"unsupported", "normalmap", "", "normal maps are not supported yet"},
@@ -102,6 +135,14 @@ const ParamSpec kParams[] = {
 
 Object* create(const CreateContext& ctx) {
   const ParamSet& p = ctx.params;
+  if (p.has("reflectance") && (p.has("eta") || p.has("k")))
+    throw Error(p.loc_of("reflectance"), "give either reflectance or eta and k, not both");
+  MicrofacetRoughness rough = microfacet_roughness(ctx);
+  TexturedRgb eta_in = ctx.rgb_input("eta"), k_in = ctx.rgb_input("k");
+  std::optional<TexturedRgb> refl_in;
+  if (p.has("reflectance")) refl_in = ctx.rgb_input("reflectance");
+  if (!rough.is_constant() || !eta_in.is_constant() || !k_in.is_constant() || (refl_in && !refl_in->is_constant()))
+    return new TexturedConductorBsdf(rough, eta_in, k_in, refl_in);
   Vec2 alpha = microfacet_alphas(p);
   float ur = alpha.x, vr = alpha.y;
   Rgb eta = p.get_rgb("eta"), k = p.get_rgb("k");
@@ -111,10 +152,8 @@ Object* create(const CreateContext& ctx) {
     Rgb r = p.get_rgb("reflectance");
     if (!(r.r >= 0.f && r.g >= 0.f && r.b >= 0.f && r.r <= 1.f && r.g <= 1.f && r.b <= 1.f))
       throw Error(p.loc_of("reflectance"), "reflectance must be in [0, 1]");
-    // R = 1 would need k = infinity; 0.9999 is indistinguishable and keeps Fresnel finite.
-    r = glm::min(r, Rgb(0.9999f));
     eta = Rgb(1.f);
-    k = 2.f * glm::sqrt(r) / glm::sqrt(Rgb(1.f) - r);
+    k = k_from_reflectance(r);
   }
   if (!(eta.r > 0.f && eta.g > 0.f && eta.b > 0.f))
     throw Error(p.loc_of("eta"), "eta must be > 0 in every channel");

@@ -8,7 +8,7 @@
 // | parameter          | default   | meaning                                                  |
 // |--------------------|-----------|----------------------------------------------------------|
 // | float eta          | 1.5       | IOR inside relative to outside (a single value)          |
-// | float roughness    | 0         | isotropic microfacet roughness                           |
+// | float roughness    | 0         | isotropic microfacet roughness (or a float texture)      |
 // | float uroughness   | roughness | roughness along the shading frame's s axis               |
 // | float vroughness   | roughness | roughness along the shading frame's t axis               |
 // | bool remaproughness| true      | alpha = sqrt(roughness) (else alpha = roughness)         |
@@ -152,11 +152,34 @@ class DielectricBsdf final : public Bsdf {
   TrowbridgeReitz distrib_;
 };
 
+// Textured roughness: each call builds the distribution at the hit and forwards to a DielectricBsdf
+// made on the stack (the constant material keeps its code and cost). Its flags are the union over
+// roughness values, since a texture may make some points smooth.
+class TexturedDielectricBsdf final : public Bsdf {
+ public:
+  TexturedDielectricBsdf(float eta, MicrofacetRoughness r) : eta_(eta), r_(r) {}
+  uint32_t flags() const override {
+    if (eta_ == 1.f) return BsdfTransmission | BsdfSpecular;
+    return BsdfReflection | BsdfTransmission | BsdfGlossy | BsdfSpecular;
+  }
+  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).f(wo, wi, ctx); }
+  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& ctx) const override {
+    return at(ctx).sample_f(wo, uc, u, ctx);
+  }
+  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).pdf(wo, wi, ctx); }
+  LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const override { return at(ctx).lobe(wo, ctx); }
+
+ private:
+  DielectricBsdf at(const ShadingContext& ctx) const { return DielectricBsdf(eta_, r_.at(ctx.tex)); }
+  float eta_;
+  MicrofacetRoughness r_;
+};
+
 const ParamSpec kParams[] = {
     {"float|spectrum", "eta", "1.5", "index of refraction inside relative to outside; a spectrum gives its luminance-weighted mean (no dispersion)"},
-    {"float", "roughness", "0", "isotropic microfacet roughness (0: smooth)"},
-    {"float", "uroughness", "", "roughness along the shading frame's s axis (default: roughness)"},
-    {"float", "vroughness", "", "roughness along the shading frame's t axis (default: roughness)"},
+    {"float texture", "roughness", "0", "isotropic microfacet roughness (0: smooth)"},
+    {"float texture", "uroughness", "", "roughness along the shading frame's s axis (default: roughness)"},
+    {"float texture", "vroughness", "", "roughness along the shading frame's t axis (default: roughness)"},
     {"bool", "remaproughness", "true", "alpha = sqrt(roughness) if true, else alpha = roughness"},
     {"unsupported", "displacement", "", "displacement is not supported"},
     {"unsupported", "normalmap", "", "normal maps are not supported yet"},
@@ -166,6 +189,8 @@ Object* create(const CreateContext& ctx) {
   const ParamSet& p = ctx.params;
   float eta = p.get_float("eta");
   if (!(eta > 0.f) || !std::isfinite(eta)) throw Error(p.loc_of("eta"), "eta must be a positive number");
+  MicrofacetRoughness rough = microfacet_roughness(ctx);
+  if (!rough.is_constant()) return new TexturedDielectricBsdf(eta, rough);
   Vec2 alpha = microfacet_alphas(p);
   float ur = alpha.x, vr = alpha.y;
   return new DielectricBsdf(eta, TrowbridgeReitz(ur, vr));

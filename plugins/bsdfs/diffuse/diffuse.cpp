@@ -3,7 +3,7 @@
 //
 // | parameter       | default     | meaning                 |
 // |-----------------|-------------|-------------------------|
-// | rgb reflectance | 0.5 0.5 0.5 | albedo, each in [0, 1]  |
+// | rgb reflectance | 0.5 0.5 0.5 | albedo, each in [0, 1]; or a spectrum texture (clamped to [0, 1]) |
 #include <penumbra/bsdf.h>
 #include <penumbra/plugin.h>
 #include <penumbra/sampling.h>
@@ -42,14 +42,36 @@ class DiffuseBsdf final : public Bsdf {
   Rgb r_;
 };
 
+// A textured reflectance: each call evaluates the texture and forwards to a DiffuseBsdf made on the
+// stack, so the constant material above keeps its code and its cost.
+class TexturedDiffuseBsdf final : public Bsdf {
+ public:
+  explicit TexturedDiffuseBsdf(TexturedRgb r) : r_(r) {}
+  uint32_t flags() const override { return BsdfReflection | BsdfDiffuse; }
+  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).f(wo, wi, ctx); }
+  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& ctx) const override {
+    return at(ctx).sample_f(wo, uc, u, ctx);
+  }
+  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).pdf(wo, wi, ctx); }
+  LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const override { return at(ctx).lobe(wo, ctx); }
+
+ private:
+  DiffuseBsdf at(const ShadingContext& ctx) const {
+    return DiffuseBsdf(glm::clamp(r_.evaluate(ctx.tex), Rgb(0.f), Rgb(1.f)));
+  }
+  TexturedRgb r_;
+};
+
 const ParamSpec kParams[] = {
-    {"rgb", "reflectance", "0.5 0.5 0.5", "albedo, each channel in [0, 1]"},
+    {"rgb texture", "reflectance", "0.5 0.5 0.5", "albedo, each channel in [0, 1], or a spectrum texture"},
     {"unsupported", "displacement", "", "displacement is not supported"},
     {"unsupported", "normalmap", "", "normal maps are not supported yet"},
 };
 
 Object* create(const CreateContext& ctx) {
-  Rgb r = ctx.params.get_rgb("reflectance");
+  TexturedRgb tex = ctx.rgb_input("reflectance");
+  if (!tex.is_constant()) return new TexturedDiffuseBsdf(tex);
+  Rgb r = tex.constant();
   if (!(r.r >= 0.f && r.g >= 0.f && r.b >= 0.f && r.r <= 1.f && r.g <= 1.f && r.b <= 1.f))
     throw Error(ctx.params.loc_of("reflectance"), "reflectance must be in [0, 1] (energy would not be conserved)");
   return new DiffuseBsdf(r);

@@ -70,7 +70,7 @@ class PathIntegrator final : public PixelIntegrator {
 
       const Bsdf& bsdf = *si->bsdf;
       Vec3 wo = si->shading.to_local(si->wo);
-      ShadingContext sctx{si->uv, TransportMode::Radiance};
+      ShadingContext sctx{si->texture_context(), TransportMode::Radiance};
 
       // Next-event estimation (the dimensions are drawn even when unused). A BSDF with delta lobes
       // among others (Disney's mirror on a diffuse base) gets it through f() and pdf() of the others;

@@ -133,7 +133,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     float u_rr = sampler.get_1d();
     if (flags == 0) break;
     Vec3 wo = si->shading.to_local(si->wo);
-    ShadingContext sctx{si->uv, TransportMode::Radiance};
+    ShadingContext sctx{si->texture_context(), TransportMode::Radiance};
     if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find_lights);
 
     // The continuation; a BSDF with diffuse and delta lobes needs it for the decision below.
@@ -152,7 +152,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
       if (depth + 1 < max_depth) {
         Rgb vp_beta = beta;
         if (has_delta) vp_beta *= float(draws_until_not_specular(bsdf, wo, sctx, sampler));
-        out.vp = VisiblePoint{si->shading, wo, si->uv, &bsdf, vp_beta, max_depth - 1 - depth};
+        out.vp = VisiblePoint{si->shading, wo, si->texture_context(), &bsdf, vp_beta, max_depth - 1 - depth};
         out.p = si->p;
         out.distance = distance;
       }

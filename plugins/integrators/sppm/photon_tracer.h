@@ -53,7 +53,7 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& depos
     float u_lobe = rng.next_float();
     Vec2 u = Vec2(rng.next_float(), rng.next_float());
     float u_rr = rng.next_float();
-    ShadingContext sctx{si->uv, TransportMode::Importance};
+    ShadingContext sctx{si->texture_context(), TransportMode::Importance};
     Vec3 wo = si->shading.to_local(si->wo);
     std::optional<BsdfSample> bs = bsdf.sample_f(wo, u_lobe, u, sctx);
     if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) return;

@@ -217,7 +217,8 @@ void SppmIntegrator::build_gather_points() {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& b) {
     for (size_t s = b.begin(); s < b.end(); ++s) {
       const VisiblePoint& vp = vps_[grid_.point_of(static_cast<uint32_t>(s))];
-      gather_[s] = GatherPoint{vp.shading, vp.wo, vp.uv, vp.bsdf, vp.max_photon_depth};
+      bool textured = vp.tex.dpdx != Vec3(0.f) || vp.tex.dpdy != Vec3(0.f);
+      gather_[s] = GatherPoint{vp.shading, vp.wo, vp.tex.uv, vp.bsdf, vp.max_photon_depth, textured};
     }
   });
 }
@@ -239,7 +240,10 @@ void SppmIntegrator::photon_pass(RenderContext& ctx, uint32_t iteration) {
           auto gather = [&](uint32_t slot) {
             const GatherPoint& g = gather_[slot];
             if (depth > g.max_photon_depth) return;
-            Rgb phi = beta * g.bsdf->f(g.wo, g.shading.to_local(wi), ShadingContext{g.uv, TransportMode::Radiance});
+            ShadingContext sc;
+            if (g.textured) sc.tex = vps_[grid_.point_of(slot)].tex;
+            else sc.tex.uv = g.uv;
+            Rgb phi = beta * g.bsdf->f(g.wo, g.shading.to_local(wi), sc);
             if (!is_finite(phi)) {
               uint32_t i = grid_.point_of(slot);
               ctx.report_nonfinite(Point2i(static_cast<int>(i % res_.x), static_cast<int>(i / res_.x)));

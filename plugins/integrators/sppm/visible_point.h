@@ -18,7 +18,7 @@ namespace penumbra::sppm {
 struct VisiblePoint {
   Frame shading;                 // shading frame at the point (the BSDF works in it)
   Vec3 wo{0.f};                  // towards the camera, in the shading frame
-  Vec2 uv{0.f};
+  TextureEvalContext tex;        // where a textured material is evaluated
   const Bsdf* bsdf = nullptr;    // null: no visible point in this pixel this iteration
   Rgb beta{0.f};                 // camera path throughput up to the point
   // Deepest photon vertex whose light may be gathered here: the camera prefix has already used
@@ -28,13 +28,15 @@ struct VisiblePoint {
 };
 
 /// What a photon needs at a visible point (its throughput is applied at the update instead), copied
-/// into the grid's slot order each iteration: 72 bytes.
+/// into the grid's slot order each iteration: 72 bytes. A textured material's full lookup context
+/// stays in the VisiblePoint (`textured`), so untextured gathers touch no more memory.
 struct GatherPoint {
   Frame shading;
   Vec3 wo{0.f};
   Vec2 uv{0.f};
   const Bsdf* bsdf = nullptr;
   int max_photon_depth = 0;
+  bool textured = false;  // the visible point's TextureEvalContext has a footprint (look it up there)
 };
 
 /// Statistics that persist across iterations (pbrt's N, r, tau) plus the camera-side sum Ld.
