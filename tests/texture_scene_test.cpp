@@ -70,7 +70,7 @@ TEST(TextureScene, UnknownTextureClassListsTheKnownOnes) {
 
 TEST(TextureScene, TextureWhereNoTextureIsAllowed) {
   EXPECT_THAT(build_error(std::string(kRough) + "Material \"dielectric\" \"texture eta\" \"rough\"\n"),
-              HasSubstr("scene.pbrt:3:23: error: parameter 'eta' of bsdf 'dielectric' must have type 'float', not 'texture'"));
+              HasSubstr("scene.pbrt:3:23: error: parameter 'eta' of bsdf 'dielectric' must have type 'float' or 'spectrum', not 'texture'"));
 }
 
 // The footprint of a pixel: a pinhole camera with a 90 degree field of view over 100 pixels spreads

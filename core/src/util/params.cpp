@@ -135,8 +135,9 @@ void ParamSet::validate(std::span<const ParamSpec> spec, const std::string& what
     if (!type_accepts(base, p.type))
       throw Error(p.loc, fmt::format("parameter '{}' of {} must have type '{}', not '{}'", p.name, what,
                                      base == "float texture" ? "float' or 'texture"
-                                     : base == "rgb texture" ? "rgb' or 'texture"
-                                                             : base,
+                                     : base == "rgb texture"  ? "rgb' or 'texture"
+                                     : base == "float|spectrum" ? "float' or 'spectrum"
+                                                                : base,
                                      p.type));
     // A texturable parameter takes as many values as the type it was given with.
     size_t n = p.count(), k = static_cast<size_t>(components(is_texturable(base) ? p.type : base));
