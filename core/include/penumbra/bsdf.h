@@ -81,4 +81,23 @@ class Bsdf : public Object {
   }
 };
 
+/// Base of a material whose parameters vary per hit (textures): Derived::at(ctx) builds the BSDF with
+/// constant parameters for the hit (on the stack), and f, sample_f, pdf and lobe forward to it;
+/// Derived still declares flags() (the union over its parameters' range).
+template <class Derived>
+class PerHitBsdf : public Bsdf {
+ public:
+  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return self().at(ctx).f(wo, wi, ctx); }
+  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& ctx) const override {
+    return self().at(ctx).sample_f(wo, uc, u, ctx);
+  }
+  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override {
+    return self().at(ctx).pdf(wo, wi, ctx);
+  }
+  LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const override { return self().at(ctx).lobe(wo, ctx); }
+
+ private:
+  const Derived& self() const { return static_cast<const Derived&>(*this); }
+};
+
 }  // namespace penumbra

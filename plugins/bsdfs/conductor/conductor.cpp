@@ -98,17 +98,13 @@ Rgb k_from_reflectance(Rgb r) {
 
 // Textured parameters: each call evaluates them at the hit and forwards to a ConductorBsdf made on
 // the stack (the constant material keeps its code and cost). Flags are the union over roughness.
-class TexturedConductorBsdf final : public Bsdf {
+class TexturedConductorBsdf final : public PerHitBsdf<TexturedConductorBsdf> {
+  friend class PerHitBsdf<TexturedConductorBsdf>;
+
  public:
   TexturedConductorBsdf(MicrofacetRoughness r, TexturedRgb eta, TexturedRgb k, std::optional<TexturedRgb> reflectance)
       : r_(r), eta_(eta), k_(k), reflectance_(reflectance) {}
   uint32_t flags() const override { return BsdfReflection | BsdfGlossy | BsdfSpecular; }
-  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).f(wo, wi, ctx); }
-  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& ctx) const override {
-    return at(ctx).sample_f(wo, uc, u, ctx);
-  }
-  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).pdf(wo, wi, ctx); }
-  LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const override { return at(ctx).lobe(wo, ctx); }
 
  private:
   ConductorBsdf at(const ShadingContext& ctx) const {

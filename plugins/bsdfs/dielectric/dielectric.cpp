@@ -155,19 +155,15 @@ class DielectricBsdf final : public Bsdf {
 // Textured roughness: each call builds the distribution at the hit and forwards to a DielectricBsdf
 // made on the stack (the constant material keeps its code and cost). Its flags are the union over
 // roughness values, since a texture may make some points smooth.
-class TexturedDielectricBsdf final : public Bsdf {
+class TexturedDielectricBsdf final : public PerHitBsdf<TexturedDielectricBsdf> {
+  friend class PerHitBsdf<TexturedDielectricBsdf>;
+
  public:
   TexturedDielectricBsdf(float eta, MicrofacetRoughness r) : eta_(eta), r_(r) {}
   uint32_t flags() const override {
     if (eta_ == 1.f) return BsdfTransmission | BsdfSpecular;
     return BsdfReflection | BsdfTransmission | BsdfGlossy | BsdfSpecular;
   }
-  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).f(wo, wi, ctx); }
-  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& ctx) const override {
-    return at(ctx).sample_f(wo, uc, u, ctx);
-  }
-  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).pdf(wo, wi, ctx); }
-  LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const override { return at(ctx).lobe(wo, ctx); }
 
  private:
   DielectricBsdf at(const ShadingContext& ctx) const { return DielectricBsdf(eta_, r_.at(ctx.tex)); }

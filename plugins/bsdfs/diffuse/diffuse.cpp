@@ -44,16 +44,12 @@ class DiffuseBsdf final : public Bsdf {
 
 // A textured reflectance: each call evaluates the texture and forwards to a DiffuseBsdf made on the
 // stack, so the constant material above keeps its code and its cost.
-class TexturedDiffuseBsdf final : public Bsdf {
+class TexturedDiffuseBsdf final : public PerHitBsdf<TexturedDiffuseBsdf> {
+  friend class PerHitBsdf<TexturedDiffuseBsdf>;
+
  public:
   explicit TexturedDiffuseBsdf(TexturedRgb r) : r_(r) {}
   uint32_t flags() const override { return BsdfReflection | BsdfDiffuse; }
-  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).f(wo, wi, ctx); }
-  std::optional<BsdfSample> sample_f(const Vec3& wo, float uc, Vec2 u, const ShadingContext& ctx) const override {
-    return at(ctx).sample_f(wo, uc, u, ctx);
-  }
-  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).pdf(wo, wi, ctx); }
-  LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const override { return at(ctx).lobe(wo, ctx); }
 
  private:
   DiffuseBsdf at(const ShadingContext& ctx) const {
