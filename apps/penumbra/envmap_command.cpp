@@ -37,7 +37,6 @@ int run_envmap(const EnvmapSettings& s) {
   if (s.size < 0) throw Error("--size must be positive");
   if (*to == envmap::Mapping::Equirectangular && s.size % 2 != 0)
     throw Error(fmt::format("--size {}: an equirectangular map is N x N/2, so N must be even", s.size));
-  if (s.supersample < 1) throw Error("--supersample must be at least 1");
 
   ImageRgb in = read_image(s.input);
   if (in.width <= 0 || in.height <= 0) throw Error(fmt::format("{} is empty", s.input));
@@ -50,16 +49,16 @@ int run_envmap(const EnvmapSettings& s) {
     width = s.size;
     height = *to == envmap::Mapping::EqualArea ? s.size : s.size / 2;
   }
-  ImageRgb out = envmap::resample(in, from, *to, width, height, s.supersample);
+  ImageRgb out = envmap::resample(in, from, *to, width, height);
   write_image(s.output, out);
 
   envmap::RgbD before = envmap::sphere_mean(in, from), after = envmap::sphere_mean(out, *to);
   auto change = [](double a, double b) { return a > 0.0 ? 100.0 * (b / a - 1.0) : 0.0; };
   std::fprintf(stderr,
-               "wrote %s: %dx%d %s from %s (%dx%d %s, %d x %d points per texel)\n"
+               "wrote %s: %dx%d %s from %s (%dx%d %s)\n"
                "mean radiance over the sphere: %.6g %.6g %.6g -> %.6g %.6g %.6g (%+.3f %%, %+.3f %%, %+.3f %%)\n",
                s.output.c_str(), width, height, envmap::mapping_name(*to), s.input.c_str(), in.width, in.height,
-               envmap::mapping_name(from), s.supersample, s.supersample, before.r, before.g, before.b, after.r, after.g,
+               envmap::mapping_name(from), before.r, before.g, before.b, after.r, after.g,
                after.b, change(before.r, after.r), change(before.g, after.g), change(before.b, after.b));
   return 0;
 }

@@ -1,6 +1,6 @@
 // `penumbra envmap`: converts an environment image between pbrt-v4's equal-area octahedral map and
-// the equirectangular (latitude-longitude) layout, resampling with supersampling so that the mean
-// radiance over the sphere is kept (docs/environment-maps.md).
+// the equirectangular (latitude-longitude) layout, resampling by exact area weighting so that the
+// mean radiance over the sphere is kept (docs/environment-maps.md).
 #pragma once
 
 #include <string>
@@ -12,7 +12,6 @@ struct EnvmapSettings {
   std::string to;           // "equalarea" or "equirectangular"
   std::string from;         // empty: by the input's shape, as the "infinite" light decides
   int size = 0;             // output width; 0: about as many texels as the input
-  int supersample = 8;      // points per output texel along each axis
 };
 
 /// Converts and writes the image; prints the sphere means before and after. Returns the exit status.

@@ -99,7 +99,6 @@ int main(int argc, char** argv) {
   envmap->add_option("--from", env.from, "mapping of the input (default: square = equalarea, 2:1 = equirectangular)");
   envmap->add_option("--size", env.size, "output width: N x N equal area, N x N/2 equirectangular (default: as many texels as the input)")
       ->check(CLI::PositiveNumber);
-  envmap->add_option("--supersample", env.supersample, "N x N points averaged per output texel")->check(CLI::Range(1, 64));
 
   std::vector<std::string> plugin_dirs;
   auto* plugins = app.add_subcommand("plugins", "List plugins with their parameters");

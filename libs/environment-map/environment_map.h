@@ -50,12 +50,13 @@ struct RgbD {
 };
 RgbD sphere_mean(const ImageRgb& img, Mapping m);
 
-/// Resamples an environment into another mapping (or size). Each output texel averages the input,
-/// read as lookup_nearest() reads it, at `supersample` x `supersample` points spread over the texel
-/// by solid angle; every input texel's contributions are then scaled so that it hands on exactly its
-/// flux (its radiance times its solid angle), so the sphere mean is kept to rounding even for a sun
-/// a few texels wide, where plain point sampling is off by a percent (docs/environment-maps.md).
-ImageRgb resample(const ImageRgb& in, Mapping from, Mapping to, int width, int height, int supersample);
+/// Resamples an environment into another mapping (or size) by exact area weighting: each output
+/// texel is the mean radiance over its solid angle of the input read as lookup_nearest() reads it,
+/// i.e. the sum over the input texels it overlaps of radiance times overlap solid angle, over its own
+/// solid angle. The overlaps are computed exactly (polygon clipping in the equal-area square, where
+/// an equirectangular texel is a trapezoid in each octant), so a constant map stays constant and the
+/// sphere mean is kept to rounding, even for a sun a few texels wide (docs/environment-maps.md).
+ImageRgb resample(const ImageRgb& in, Mapping from, Mapping to, int width, int height);
 
 /// The output size that keeps the texel count about equal: equal area -> N x N with N = round(sqrt(w h)),
 /// equirectangular -> 2H x H with 2 H^2 about N^2.
