@@ -1,4 +1,5 @@
-// The renderable scene: Embree 3 geometry (triangle meshes and native sphere points) plus what a hit
+// The renderable scene: Embree 3 geometry (triangle meshes, native sphere points, and disks and
+// cylinders as user geometry with analytic intersection) plus what a hit
 // needs to become a SurfaceInteraction (material, area lights, orientation).
 #pragma once
 
@@ -6,6 +7,7 @@
 #include <penumbra/sampling.h>
 #include <penumbra/scene.h>
 
+#include "scene/quadrics.h"
 #include "scene/sphere.h"
 #include "scene/triangle_mesh.h"
 
@@ -26,6 +28,7 @@ class EmbreeScene final : public Scene {
   /// Adds a mesh; `lights` is empty or holds one area light per triangle.
   void add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf, std::vector<const Light*> lights);
   void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light);
+  void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light);
   /// Meshes and spheres kept for area lights to reference before commit().
   const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
 
@@ -52,6 +55,7 @@ class EmbreeScene final : public Scene {
   struct Geometry {
     const TriangleMesh* mesh = nullptr;  // one of these two
     const Sphere* sphere = nullptr;
+    const Quadric* quadric = nullptr;
     const Bsdf* bsdf = nullptr;
     std::vector<const Light*> lights;    // per primitive, or empty
   };
@@ -60,6 +64,7 @@ class EmbreeScene final : public Scene {
   RTCScene scene_ = nullptr;
   std::vector<std::unique_ptr<TriangleMesh>> meshes_;
   std::vector<std::unique_ptr<Sphere>> spheres_;
+  std::vector<std::unique_ptr<Quadric>> quadrics_;
   std::vector<std::unique_ptr<Triangle>> light_shapes_;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
   std::vector<const Light*> lights_, infinite_;
