@@ -263,7 +263,7 @@ Sampler "independent" "integer pixelsamples" [ 4 ]
 WorldBegin
 AttributeBegin
   Rotate -90 1 0 0
-  LightSource "infinite" "string filename" [ "{}/scenes/environment/sky.exr" ]
+  LightSource "infinite" "string filename" [ "{}/scenes/environment/sky.exr" ] "string mapping" [ "equirectangular" ]
 AttributeEnd
 LightSource "distant" "rgb L" [ 2 2 2 ] "point3 from" [ 1 3 1 ] "point3 to" [ 0 0 0 ]
 Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]

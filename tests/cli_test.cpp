@@ -150,9 +150,10 @@ TEST(Cli, UndefinedNamedMaterialIsLocated) {
 }
 
 TEST(Cli, UnsupportedShapeIsLocated) {
-  auto r = render_text("disk", scene_with("", "Shape \"disk\"\n"));
+  auto r = render_text("curve", scene_with("", "Shape \"curve\"\n"));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: unsupported shape 'disk'; available: gltf, plymesh, sphere, trianglemesh"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: unsupported shape 'curve'; available: cylinder, disk, gltf, plymesh, "
+                               "sphere, trianglemesh"));
 }
 
 TEST(Cli, KnownButUnsupportedPbrtParameterSaysSo) {

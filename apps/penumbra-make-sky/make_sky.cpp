@@ -2,7 +2,9 @@
 // horizon, a dim ground below it, and a small, very bright sun disk. The sky that ships in
 // scenes/environment/ was made with `penumbra-make-sky scenes/environment/sky.exr`.
 //
-// Mapping (as the "infinite" light reads it): column u = phi / 2pi, row v = theta / pi, +z up.
+// Mapping: equirectangular, column u = phi / 2pi, row v = theta / pi, +z up. The "infinite" light
+// reads a 2:1 image that way only with "string mapping" "equirectangular" (or with a warning);
+// `penumbra envmap OUT.exr SKY.exr --to equalarea` makes the square equal-area map pbrt-v4 reads.
 //
 // Usage: penumbra-make-sky OUT.exr [WIDTH HEIGHT SUN_ELEVATION_DEG SUN_AZIMUTH_DEG SUN_RADIANCE]
 #include <penumbra/color.h>

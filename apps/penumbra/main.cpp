@@ -3,8 +3,10 @@
 //   penumbra render SCENE [opts]   renders a scene, command-line options override the file
 //   penumbra plugins               lists the plugins found and their parameters
 //   penumbra merge PARTS -o OUT    combines the parts of a split render (docs/farm.md)
+//   penumbra envmap IN OUT --to M  converts an environment image (docs/environment-maps.md)
 #include "commands.h"
 #include "converge.h"
+#include "envmap_command.h"
 
 #include <penumbra/error.h>
 #include <penumbra/version.h>
@@ -89,6 +91,15 @@ int main(int argc, char** argv) {
   merge->add_option("parts", merge_parts, "EXR parts written with --spp-total")->required()->check(CLI::ExistingFile);
   merge->add_option("-o,--output", merge_output, "merged image (.exr)")->required();
 
+  penumbra::cli::EnvmapSettings env;
+  auto* envmap = app.add_subcommand("envmap", "Convert an environment image between pbrt-v4's equal-area map and equirectangular");
+  envmap->add_option("input", env.input, "environment image")->required()->check(CLI::ExistingFile);
+  envmap->add_option("output", env.output, "converted image (.exr, .pfm, .hdr, .tif)")->required();
+  envmap->add_option("--to", env.to, "mapping to write: equalarea (pbrt-v4's) or equirectangular")->required();
+  envmap->add_option("--from", env.from, "mapping of the input (default: square = equalarea, 2:1 = equirectangular)");
+  envmap->add_option("--size", env.size, "output width: N x N equal area, N x N/2 equirectangular (default: as many texels as the input)")
+      ->check(CLI::PositiveNumber);
+
   std::vector<std::string> plugin_dirs;
   auto* plugins = app.add_subcommand("plugins", "List plugins with their parameters");
   plugins->add_option("--dir", plugin_dirs, "search these folders instead of the default path");
@@ -109,6 +120,7 @@ int main(int argc, char** argv) {
   try {
     if (*plugins) return penumbra::cli::run_plugins(plugin_dirs);
     if (*merge) return penumbra::cli::run_merge(merge_parts, merge_output);
+    if (*envmap) return penumbra::cli::run_envmap(env);
     if (*converge) {
       conv.configs = penumbra::cli::parse_configs(conv_configs);
       if (!conv_res.empty()) conv.resolution = parse_resolution(conv_res);

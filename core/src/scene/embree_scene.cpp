@@ -46,7 +46,7 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
   unsigned id = rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);
   if (geometries_.size() <= id) geometries_.resize(id + 1);
-  geometries_[id] = Geometry{mesh.get(), nullptr, bsdf, std::move(lights), textured};
+  geometries_[id] = Geometry{mesh.get(), nullptr, nullptr, bsdf, std::move(lights), textured};
   meshes_.push_back(std::move(mesh));
 }
 
@@ -64,8 +64,64 @@ void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, c
   if (geometries_.size() <= id) geometries_.resize(id + 1);
   std::vector<const Light*> lights;
   if (light) lights.push_back(light);
-  geometries_[id] = Geometry{nullptr, sphere.get(), bsdf, std::move(lights), textured};
+  geometries_[id] = Geometry{nullptr, sphere.get(), nullptr, bsdf, std::move(lights), textured};
   spheres_.push_back(std::move(sphere));
+}
+
+// User-geometry callbacks for disks and cylinders (one primitive per geometry; rays come one at a
+// time from rtcIntersect1/rtcOccluded1).
+static void quadric_bounds(const RTCBoundsFunctionArguments* args) {
+  Bounds3 b = static_cast<const Quadric*>(args->geometryUserPtr)->world_bounds();
+  RTCBounds* out = args->bounds_o;
+  out->lower_x = b.min.x, out->lower_y = b.min.y, out->lower_z = b.min.z;
+  out->upper_x = b.max.x, out->upper_y = b.max.y, out->upper_z = b.max.z;
+}
+
+static void quadric_intersect(const RTCIntersectFunctionNArguments* args) {
+  if (args->N != 1 || !args->valid[0]) return;
+  auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+  Ray ray{Vec3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z), Vec3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z)};
+  auto t = static_cast<const Quadric*>(args->geometryUserPtr)->intersect(ray, rh->ray.tnear, rh->ray.tfar);
+  if (!t) return;
+  rh->ray.tfar = *t;
+  rh->hit.geomID = args->geomID;
+  rh->hit.primID = args->primID;
+  rh->hit.u = rh->hit.v = 0.f;
+  rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0.f;  // the surface is rebuilt from t in intersect()
+  rh->hit.instID[0] = args->context->instID[0];
+}
+
+static void quadric_occluded(const RTCOccludedFunctionNArguments* args) {
+  if (args->N != 1 || !args->valid[0]) return;
+  auto* r = reinterpret_cast<RTCRay*>(args->ray);
+  Ray ray{Vec3(r->org_x, r->org_y, r->org_z), Vec3(r->dir_x, r->dir_y, r->dir_z)};
+  if (static_cast<const Quadric*>(args->geometryUserPtr)->intersect(ray, r->tnear, r->tfar)) r->tfar = -INFINITY;
+}
+
+void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light,
+                               bool textured) {
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, 1);
+  rtcSetGeometryUserData(geom, quadric.get());
+  rtcSetGeometryBoundsFunction(geom, quadric_bounds, nullptr);
+  rtcSetGeometryIntersectFunction(geom, quadric_intersect);
+  rtcSetGeometryOccludedFunction(geom, quadric_occluded);
+  Bounds3 b = quadric->world_bounds();
+  bounds_.extend(b.min);
+  bounds_.extend(b.max);
+  rtcCommitGeometry(geom);
+  unsigned id = rtcAttachGeometry(scene_, geom);
+  rtcReleaseGeometry(geom);
+  if (geometries_.size() <= id) geometries_.resize(id + 1);
+  std::vector<const Light*> lights;
+  if (light) lights.push_back(light);
+  Geometry g;
+  g.quadric = quadric.get();
+  g.bsdf = bsdf;
+  g.lights = std::move(lights);
+  g.textured = textured;
+  geometries_[id] = std::move(g);
+  quadrics_.push_back(std::move(quadric));
 }
 
 void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const Light*> infinite) {
@@ -130,7 +186,8 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   si.shape_id = rh.hit.geomID;
   si.prim_id = rh.hit.primID;
   si.bsdf = g.bsdf;
-  if (!g.lights.empty()) si.area_light = g.lights[g.sphere ? 0 : rh.hit.primID];
+  if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? rh.hit.primID : 0];
+  Vec3 quadric_dpdu(0.f), quadric_dpdv(0.f);
   if (g.mesh) {
     // The hit point comes from the barycentrics: its error does not grow with t.
     Vec3 b(1.f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v);
@@ -140,6 +197,14 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
     si.ng = s.ng;
     si.ns = s.ns;
     si.uv = s.uv;
+  } else if (g.quadric) {
+    Quadric::Surface s = g.quadric->surface_at(ray, si.t);
+    quadric_dpdu = s.dpdu;
+    quadric_dpdv = s.dpdv;
+    si.p = s.p;
+    si.p_error = s.p_error;
+    si.ng = si.ns = s.n;
+    si.uv = s.uv;
   } else {
     si.p = g.sphere->reproject(ray.o + si.t * ray.d);
     si.p_error = error_gamma(5) * glm::abs(si.p);
@@ -147,16 +212,18 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
     si.uv = g.sphere->uv_at(si.p);
   }
   si.shading = Frame(si.ns);
-  if (g.textured) add_texture_footprint(si, g);
+  if (g.textured) add_texture_footprint(si, g, quadric_dpdu, quadric_dpdv);
   return si;
 }
 
 // pbrt-v4's differentials without ray differentials: the camera estimates how far p moves per
 // pixel, and (du, dv) follow from dp = du dpdu + dv dpdv by least squares in the tangent plane.
-void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Geometry& g) const {
+void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Geometry& g, const Vec3& quadric_dpdu,
+                                        const Vec3& quadric_dpdv) const {
   Vec3 dpdu, dpdv;
   if (g.mesh) g.mesh->uv_derivatives(si.prim_id, &dpdu, &dpdv);
-  else g.sphere->uv_derivatives(si.p, &dpdu, &dpdv);
+  else if (g.sphere) g.sphere->uv_derivatives(si.p, &dpdu, &dpdv);
+  else dpdu = quadric_dpdu, dpdv = quadric_dpdv;
   camera_->approximate_dp_dxy(si.p, si.ng, &si.dpdx, &si.dpdy);
   si.dpdx *= footprint_scale_;
   si.dpdy *= footprint_scale_;

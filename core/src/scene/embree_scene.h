@@ -1,4 +1,5 @@
-// The renderable scene: Embree 3 geometry (triangle meshes and native sphere points) plus what a hit
+// The renderable scene: Embree 3 geometry (triangle meshes, native sphere points, and disks and
+// cylinders as user geometry with analytic intersection) plus what a hit
 // needs to become a SurfaceInteraction (material, area lights, orientation).
 #pragma once
 
@@ -6,6 +7,7 @@
 #include <penumbra/sampling.h>
 #include <penumbra/scene.h>
 
+#include "scene/quadrics.h"
 #include "scene/sphere.h"
 #include "scene/triangle_mesh.h"
 
@@ -31,6 +33,7 @@ class EmbreeScene final : public Scene {
   /// Multiplies the texture footprint: pbrt-v4's max(1/8, 1/sqrt(spp)), since many samples per pixel
   /// already average what a wider filter would. 1 until set.
   void set_texture_footprint_scale(float s) { footprint_scale_ = s; }
+  void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light, bool textured = false);
   /// Meshes and spheres kept for area lights to reference before commit().
   const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
 
@@ -57,16 +60,19 @@ class EmbreeScene final : public Scene {
   struct Geometry {
     const TriangleMesh* mesh = nullptr;  // one of these two
     const Sphere* sphere = nullptr;
+    const Quadric* quadric = nullptr;
     const Bsdf* bsdf = nullptr;
     std::vector<const Light*> lights;    // per primitive, or empty
     bool textured = false;
   };
-  void add_texture_footprint(SurfaceInteraction& si, const Geometry& g) const;
+  void add_texture_footprint(SurfaceInteraction& si, const Geometry& g, const Vec3& quadric_dpdu,
+                             const Vec3& quadric_dpdv) const;
 
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   std::vector<std::unique_ptr<TriangleMesh>> meshes_;
   std::vector<std::unique_ptr<Sphere>> spheres_;
+  std::vector<std::unique_ptr<Quadric>> quadrics_;
   std::vector<std::unique_ptr<Triangle>> light_shapes_;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
   std::vector<const Light*> lights_, infinite_;

@@ -41,9 +41,20 @@ const ParamSpec kSphereParams[] = {
     {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
 };
 
-std::string folder_of(const std::string& path) {
-  return std::filesystem::path(path).parent_path().string();
-}
+const ParamSpec kDiskParams[] = {
+    {"float", "height", "0", "z of the disk's plane in object space"},
+    {"float", "radius", "1", "outer radius"},
+    {"float", "innerradius", "0", "inner radius (an annulus when > 0)"},
+    {"float", "phimax", "360", "largest azimuth in degrees (a sector when < 360)"},
+    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+};
+const ParamSpec kCylinderParams[] = {
+    {"float", "radius", "1", "radius in object space"},
+    {"float", "zmin", "-1", "lower end along z"},
+    {"float", "zmax", "1", "upper end along z"},
+    {"float", "phimax", "360", "largest azimuth in degrees"},
+    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+};
 
 std::string resolve(const std::string& base_dir, const std::string& file) {
   std::filesystem::path p(file);
@@ -153,6 +164,39 @@ void build_textures(SceneDescription& desc, Registry& registry, BuiltScene& out)
     }
     out.textures.push_back(std::move(obj));
   }
+}
+
+// Disks and cylinders take any affine transform (not a projection).
+void check_affine(const ShapeEntity& e) {
+  const Mat4& m = e.to_world;
+  if (m[0][3] != 0.f || m[1][3] != 0.f || m[2][3] != 0.f || m[3][3] != 1.f)
+    throw Error(e.loc, fmt::format("a {} under a projective transform is not supported", e.type));
+  if (glm::determinant(glm::mat3(m)) == 0.f) throw Error(e.loc, fmt::format("the {}'s transform is singular", e.type));
+}
+
+float phimax_of(ShapeEntity& e) {
+  float phimax = e.params.get_float("phimax");
+  if (!(phimax > 0.f && phimax <= 360.f)) throw Error(e.params.loc_of("phimax"), "phimax must be in (0, 360]");
+  return phimax;
+}
+
+std::unique_ptr<Quadric> load_quadric(ShapeEntity& e) {
+  bool flip = e.reverse_orientation != swaps_handedness(e.to_world);
+  if (e.type == "disk") {
+    e.params.validate(kDiskParams, "shape 'disk'");
+    check_affine(e);
+    float r = e.params.get_float("radius"), ri = e.params.get_float("innerradius");
+    if (!(r > 0.f) || !std::isfinite(r)) throw Error(e.params.loc_of("radius"), "disk radius must be > 0");
+    if (!(ri >= 0.f && ri < r)) throw Error(e.params.loc_of("innerradius"), "innerradius must be in [0, radius)");
+    return std::make_unique<Disk>(e.to_world, flip, e.params.get_float("height"), r, ri, phimax_of(e));
+  }
+  e.params.validate(kCylinderParams, "shape 'cylinder'");
+  check_affine(e);
+  float r = e.params.get_float("radius"), z0 = e.params.get_float("zmin"), z1 = e.params.get_float("zmax");
+  if (!(r > 0.f) || !std::isfinite(r)) throw Error(e.params.loc_of("radius"), "cylinder radius must be > 0");
+  if (!(z0 != z1) || !std::isfinite(z0) || !std::isfinite(z1))
+    throw Error(e.params.has("zmax") ? e.params.loc_of("zmax") : e.loc, "cylinder zmin and zmax must differ");
+  return std::make_unique<Cylinder>(e.to_world, flip, r, z0, z1, phimax_of(e));
 }
 
 }  // namespace
@@ -307,8 +351,20 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       std::unique_ptr<Sphere> sphere = load_sphere(s);
       const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get()) : nullptr;
       out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s));
+    } else if (s.type == "disk" || s.type == "cylinder") {
+      const Bsdf* bsdf = material_of(s);
+      std::unique_ptr<Quadric> quadric = load_quadric(s);
+      const Light* light = nullptr;
+      if (s.area_light >= 0) {
+        if (!quadric->area_is_uniform())
+          throw Error(s.loc, "a cylinder area light whose transform stretches its cross-section unevenly is not "
+                             "supported (its emission could not be sampled uniformly by area)");
+        light = make_area_light(s, quadric.get());
+      }
+      out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s));
     } else {
-      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: gltf, plymesh, sphere, trianglemesh", s.type));
+      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: cylinder, disk, gltf, plymesh, sphere, trianglemesh",
+                                     s.type));
     }
   }
   out.scene->adopt_shapes(std::move(light_triangles));

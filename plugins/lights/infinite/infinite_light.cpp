@@ -1,33 +1,40 @@
 // Light "infinite": radiance arriving from infinitely far away, either constant ("rgb L") or from an
-// equirectangular HDR image ("string filename", any float format OpenImageIO reads), oriented by the
-// transform in effect at the LightSource directive.
+// HDR image ("string filename", any float format OpenImageIO reads), oriented by the transform in
+// effect at the LightSource directive.
 //
-// | parameter       | default | meaning                                               |
-// |-----------------|---------|-------------------------------------------------------|
-// | rgb L           | 1 1 1   | constant radiance (when there is no image)            |
-// | string filename | ""      | equirectangular environment map                       |
-// | float scale     | 1       | multiplies the radiance                               |
+// | parameter       | default | meaning                                                          |
+// |-----------------|---------|------------------------------------------------------------------|
+// | rgb L           | 1 1 1   | constant radiance (when there is no image)                       |
+// | string filename | ""      | environment image                                                |
+// | string mapping  | ""      | Penumbra: "equalarea" or "equirectangular"; empty: by the shape  |
+// | float scale     | 1       | multiplies the radiance                                          |
 //
-// Mapping, in light space: u = phi / 2pi, v = theta / pi (row 0 is +z, theta = 0), with
-// w = (sin theta cos phi, sin theta sin phi, cos theta). Radiance is constant over each texel, and the
-// texels are importance sampled by a 2D piecewise-constant distribution of luminance x sin(theta), so
-// the pdf per solid angle is pdf_uv / (2 pi^2 sin theta) exactly. The distribution is built only when
-// the scene has an image-based environment.
+// Mappings (libs/environment-map, light space z-up): a square image is pbrt-v4's equal-area
+// octahedral map; an equirectangular one (u = phi / 2pi, v = theta / pi, row 0 is +z) is read only
+// when "mapping" says so, or, for a 2:1 image without it, with a warning (pbrt-v4 refuses those).
+// Radiance is constant over each texel, and the texels are importance sampled by a 2D piecewise-
+// constant distribution over the image, so the pdf per solid angle is exact: pdf_uv / (4 pi) for the
+// equal-area map (its texels all cover the same solid angle, the distribution is luminance alone),
+// pdf_uv / (2 pi^2 sin theta) for the equirectangular one (distribution luminance x sin theta). The
+// distribution is built only when the scene has an image-based environment.
 #include <penumbra/image.h>
 #include <penumbra/light.h>
 #include <penumbra/plugin.h>
 #include <penumbra/sampling.h>
+
+#include "environment_map.h"
 
 #include <filesystem>
 
 namespace {
 
 using namespace penumbra;
+using envmap::Mapping;
 
 class InfiniteLight final : public Light {
  public:
-  InfiniteLight(const Mat4& to_world, Rgb constant, ImageRgb image, float scale)
-      : constant_(constant * scale), image_(std::move(image)), scale_(scale) {
+  InfiniteLight(const Mat4& to_world, Rgb constant, ImageRgb image, Mapping mapping, float scale)
+      : constant_(constant * scale), image_(std::move(image)), mapping_(mapping), scale_(scale) {
     glm::mat3 m(to_world);
     // Only the rotation matters for directions; remove any uniform scale.
     to_world_ = glm::mat3(glm::normalize(m[0]), glm::normalize(m[1]), glm::normalize(m[2]));
@@ -62,11 +69,9 @@ class InfiniteLight final : public Light {
     } else {
       float pdf_uv;
       Vec2 uv = distribution_.sample_continuous(u, &pdf_uv);
-      float theta = uv.y * Pi, phi = uv.x * 2.f * Pi;
-      float sin_theta = std::sin(theta);
-      if (pdf_uv == 0.f || sin_theta <= 0.f) return std::nullopt;
-      w_light = Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), std::cos(theta));
-      pdf = pdf_uv / (2.f * Pi * Pi * sin_theta);
+      if (pdf_uv == 0.f) return std::nullopt;
+      w_light = envmap::uv_to_direction(mapping_, uv);
+      pdf = pdf_uv_to_solid_angle(pdf_uv, w_light);
     }
     Rgb L = radiance(w_light);
     if (is_black(L) || !(pdf > 0.f)) return std::nullopt;
@@ -78,10 +83,7 @@ class InfiniteLight final : public Light {
   float pdf_li(const LightSampleContext&, const Vec3& wi, const SurfaceInteraction&) const override {
     if (!has_image()) return uniform_sphere_pdf();
     Vec3 w = to_light_ * glm::normalize(wi);
-    float cos_theta = std::clamp(w.z, -1.f, 1.f);
-    float sin_theta = std::sqrt(std::max(0.f, 1.f - cos_theta * cos_theta));
-    if (sin_theta <= 0.f) return 0.f;
-    return distribution_.pdf(direction_to_uv(w)) / (2.f * Pi * Pi * sin_theta);
+    return pdf_uv_to_solid_angle(distribution_.pdf(envmap::direction_to_uv(mapping_, w)), w);
   }
 
   // A direction as sample_li() draws it, and an origin on a disk of the scene's radius perpendicular
@@ -109,11 +111,11 @@ class InfiniteLight final : public Light {
  private:
   bool has_image() const { return image_.width > 0; }
 
-  static Vec2 direction_to_uv(const Vec3& w) {
-    float theta = std::acos(std::clamp(w.z, -1.f, 1.f));
-    float phi = std::atan2(w.y, w.x);
-    if (phi < 0.f) phi += 2.f * Pi;
-    return Vec2(std::min(phi * Inv2Pi, OneMinusEpsilon), std::min(theta * InvPi, OneMinusEpsilon));
+  // Equal-area texels all cover 4 pi / (w h) sr; equirectangular ones d(omega) = 2 pi^2 sin(theta) du dv.
+  float pdf_uv_to_solid_angle(float pdf_uv, const Vec3& w_light) const {
+    if (mapping_ == Mapping::EqualArea) return pdf_uv * Inv4Pi;
+    float sin_theta = safe_sqrt(1.f - w_light.z * w_light.z);
+    return sin_theta > 0.f ? pdf_uv / (2.f * Pi * Pi * sin_theta) : 0.f;
   }
 
   Rgb texel(int x, int y) const {
@@ -123,32 +125,27 @@ class InfiniteLight final : public Light {
 
   Rgb radiance(const Vec3& w_light) const {
     if (!has_image()) return constant_;
-    Vec2 uv = direction_to_uv(w_light);
-    int x = std::min(static_cast<int>(uv.x * image_.width), image_.width - 1);
-    int y = std::min(static_cast<int>(uv.y * image_.height), image_.height - 1);
-    return texel(x, y);
+    return envmap::lookup_nearest(image_, envmap::direction_to_uv(mapping_, w_light)) * scale_;
   }
 
+  // Texel weights proportional to luminance times solid angle (the equirectangular rows' sin theta at
+  // the row centre), and the sphere mean of the radiance for power().
   void build_distribution() {
     std::vector<float> f(static_cast<size_t>(image_.width) * image_.height);
-    Rgb sum(0.f);
-    double weight = 0.0;
     for (int y = 0; y < image_.height; ++y) {
-      float sin_theta = std::sin(Pi * (y + 0.5f) / image_.height);
-      for (int x = 0; x < image_.width; ++x) {
-        Rgb L = texel(x, y);
-        f[static_cast<size_t>(y) * image_.width + x] = std::max(0.f, luminance(L)) * sin_theta;
-        sum += L * sin_theta;
-        weight += sin_theta;
-      }
+      float row_weight = mapping_ == Mapping::EqualArea ? 1.f : std::sin(Pi * (y + 0.5f) / image_.height);
+      for (int x = 0; x < image_.width; ++x)
+        f[static_cast<size_t>(y) * image_.width + x] = std::max(0.f, luminance(texel(x, y))) * row_weight;
     }
     distribution_ = Distribution2D(f, image_.width, image_.height);
-    mean_radiance_ = sum / static_cast<float>(weight);
+    envmap::RgbD mean = envmap::sphere_mean(image_, mapping_);
+    mean_radiance_ = Rgb(static_cast<float>(mean.r), static_cast<float>(mean.g), static_cast<float>(mean.b)) * scale_;
   }
 
   glm::mat3 to_world_{1.f}, to_light_{1.f};
   Rgb constant_;
   ImageRgb image_;
+  Mapping mapping_;
   float scale_;
   Distribution2D distribution_;
   Rgb mean_radiance_{0.f};
@@ -158,17 +155,47 @@ class InfiniteLight final : public Light {
 
 const ParamSpec kParams[] = {
     {"rgb", "L", "1 1 1", "constant radiance (used when there is no image)"},
-    {"string", "filename", "", "equirectangular environment map (.exr, .hdr, ...)"},
+    {"string", "filename", "", "environment image (.exr, .hdr, .pfm, ...): square = pbrt-v4's equal-area map"},
+    {"string", "mapping", "", "Penumbra: \"equalarea\" or \"equirectangular\" (default: equal area for a square "
+                              "image, equirectangular with a warning for a 2:1 one)"},
     {"float", "scale", "1", "multiplies the radiance"},
     {"unsupported", "illuminance", "", "give the radiance scale instead"},
     {"unsupported", "portal", "", "portals are not supported"},
 };
+
+// Which mapping an image is read in: the scene's "mapping" if given, else pbrt-v4's rule (a square
+// image is equal-area), else for a 2:1 image equirectangular with a warning; any other shape is an
+// error, as in pbrt-v4.
+Mapping choose_mapping(const CreateContext& ctx, const std::string& path, const ImageRgb& image) {
+  std::string size = std::to_string(image.width) + "x" + std::to_string(image.height);
+  if (ctx.params.has("mapping")) {
+    std::string name = ctx.params.get_string("mapping");
+    std::optional<Mapping> m = envmap::parse_mapping(name);
+    if (!m) throw Error(ctx.params.loc_of("mapping"), "unknown mapping \"" + name + "\": expected \"equalarea\" or \"equirectangular\"");
+    if (*m == Mapping::EqualArea && image.width != image.height)
+      throw Error(ctx.params.loc_of("mapping"), "environment map " + path + " is " + size +
+                                                    ": an equal-area map must be square");
+    return *m;
+  }
+  std::optional<Mapping> m = envmap::mapping_from_shape(image.width, image.height);
+  if (!m)
+    throw Error(ctx.params.loc_of("filename"),
+                "environment map " + path + " is " + size + ": neither square (pbrt-v4's equal-area map) nor 2:1; "
+                "say \"string mapping\" \"equirectangular\" if it is a latitude-longitude image");
+  if (*m == Mapping::Equirectangular)
+    warning(ctx.params.loc_of("filename"),
+            "environment map " + path + " is " + size + ", not square: read as equirectangular (latitude-longitude, "
+            "+z at the top row), which pbrt-v4 would refuse. Say \"string mapping\" \"equirectangular\" to confirm, "
+            "or convert it with `penumbra envmap --to equalarea`");
+  return *m;
+}
 
 Object* create(const CreateContext& ctx) {
   float scale = ctx.params.get_float("scale");
   if (!(scale >= 0.f) || !std::isfinite(scale)) throw Error(ctx.params.loc_of("scale"), "scale must be finite and >= 0");
   std::string file = ctx.params.get_string("filename");
   ImageRgb image;
+  Mapping mapping = Mapping::EqualArea;
   if (!file.empty()) {
     if (ctx.params.has("L")) throw Error(ctx.params.loc_of("L"), "give either \"L\" or \"filename\", not both");
     std::filesystem::path p(file);
@@ -182,13 +209,17 @@ Object* create(const CreateContext& ctx) {
     for (float v : image.pixels)
       if (!std::isfinite(v) || v < 0.f)
         throw Error(ctx.params.loc_of("filename"), "environment map " + p.string() + " has negative or non-finite texels");
+    mapping = choose_mapping(ctx, p.string(), image);
+  } else if (ctx.params.has("mapping")) {
+    throw Error(ctx.params.loc_of("mapping"), "\"mapping\" applies to an image: give \"filename\" too");
   }
   Rgb L = ctx.params.get_rgb("L");
   if (!(L.r >= 0.f && L.g >= 0.f && L.b >= 0.f) || !is_finite(L))
     throw Error(ctx.params.loc_of("L"), "radiance must be finite and non-negative");
-  return new InfiniteLight(ctx.to_world, L, std::move(image), scale);
+  return new InfiniteLight(ctx.to_world, L, std::move(image), mapping, scale);
 }
 
 }  // namespace
 
-PENUMBRA_PLUGIN(Light, "infinite", "environment light: constant or equirectangular HDR image, importance sampled", kParams, create)
+PENUMBRA_PLUGIN(Light, "infinite", "environment light: constant or HDR image (equal-area or equirectangular), importance sampled",
+                kParams, create)
