@@ -1,5 +1,6 @@
 #include "commands.h"
 
+#include "image/image_io.h"
 #include "registry/registry.h"
 #include "render/merge.h"
 
@@ -41,7 +42,9 @@ int run_render(const RenderSettings& settings) {
 
 int run_merge(const std::vector<std::string>& parts, const std::string& output) {
   if (fs::path(output).extension() != ".exr")
-    throw Error(fmt::format("merge writes a multilayer EXR: the output '{}' must end in .exr", output));
+    throw Error(fmt::format("-o: merge writes a multilayer EXR: the output '{}' must end in .exr", output));
+  if (std::string problem = image_output_problem(output); !problem.empty())
+    throw Error(fmt::format("-o: {}", problem));
   MergeResult merged = merge_parts(parts);
   for (const auto& note : merged.notes) std::fprintf(stderr, "note: %s\n", note.c_str());
   write_layered_exr(output, merged.image);
