@@ -1,5 +1,6 @@
 #include "image/exr_layers.h"
 
+#include "util/input_file.h"
 #include "util/output_file.h"
 
 #include <penumbra/error.h>
@@ -65,6 +66,9 @@ void write_layered_exr(const std::string& path, const LayeredImage& image) {
 }
 
 LayeredImage read_layered_exr(const std::string& path) {
+  // Only regular files (util/input_file.h): a device or FIFO named as an image is refused, not read.
+  if (std::string problem = input_file_problem(path); !problem.empty())
+    throw Error(fmt::format("cannot read image '{}': {}", path, problem));
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();

@@ -1,5 +1,6 @@
 #include "image/image_io.h"
 
+#include "util/input_file.h"
 #include "util/output_file.h"
 
 #include <penumbra/error.h>
@@ -221,6 +222,9 @@ void write_image(const std::string& path, const ImageRgb& img,
 }
 
 ImageRgb read_image(const std::string& path, ImageFileInfo* info) {
+  // Only regular files (util/input_file.h): a device or FIFO named as an image is refused, not read.
+  if (std::string problem = input_file_problem(path); !problem.empty())
+    throw Error(fmt::format("cannot read image '{}': {}", path, problem));
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();

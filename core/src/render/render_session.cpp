@@ -8,6 +8,7 @@
 #include "render/ray_counter.h"
 #include "render/render_outputs.h"
 #include "render/scene_hash.h"
+#include "render/scene_warnings.h"
 #include "scene/scene_builder.h"
 #include "util/output_file.h"
 
@@ -389,6 +390,7 @@ RenderResult render(const RenderSettings& settings) {
         throw Error(fmt::format("{}: {}", *p.loc.filename, e.what()));
     throw;
   }
+  report_silent_results(silent_result_warnings(desc, built), settings.strict);
   built.film->set_firefly_threshold(settings.firefly_threshold);
   RenderOptions options;
   options.time_budget = settings.time_budget;

@@ -52,6 +52,7 @@ struct RenderSettings {
   std::optional<std::pair<int, int>> resolution;  // --res WxH
   std::string stats_file;                // --stats FILE.json
   bool quiet = false;                    // no progress output
+  bool strict = false;                   // --strict: scenes that render black (render/scene_warnings.h) are errors
   float firefly_threshold = 1000.f;      // samples brighter than this (max component) are counted
   std::vector<std::string> plugin_dirs;  // default: Registry::default_search_dirs()
   /// Snapshots for convergence studies: after the first complete pass at or past each of these
