@@ -60,7 +60,7 @@ TEST(Memory, AbsurdResolutionFailsAtOnceWithTheEstimate) {
                                "but only "));
   EXPECT_THAT(r.err, HasSubstr(" of memory are available"));
   EXPECT_THAT(r.err, ::testing::Not(HasSubstr("bad_alloc")));
-  EXPECT_LT(seconds, 2.0);
+  EXPECT_LT(seconds, 10.0);  // about 0.5 s unloaded; the film alone would take minutes to zero-fill
   EXPECT_FALSE(std::ifstream(dir + "/o.exr").good());
 }
 

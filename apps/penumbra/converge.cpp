@@ -50,6 +50,7 @@ RenderSettings base_settings(const ConvergeSettings& s, const ConvergeConfig& co
   r.resolution = s.resolution;
   r.threads = s.threads;
   r.quiet = true;
+  r.image_written = false;  // snapshots and results go to the study folder, checked in run_converge
   return r;
 }
 

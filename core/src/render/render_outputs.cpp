@@ -81,7 +81,7 @@ SampleRange apply_output_settings(const RenderSettings& settings, SceneDescripti
   if (set.any()) desc.film.params.set_string("aovs", set.names());
 
   ImageOutput out = image_output(settings, desc);
-  std::string problem = image_output_problem(out.path);
+  std::string problem = settings.image_written ? image_output_problem(out.path) : "";
   if (!problem.empty()) throw output_error(out, problem);
   if (range.split && !is_exr_path(out.path))
     throw output_error(out, fmt::format("a part of a split render must be written as .exr (for `penumbra merge`), "
