@@ -19,6 +19,16 @@ function(penumbra_add_plugin NAME KIND)
     message(FATAL_ERROR "penumbra_add_plugin(${NAME} ${KIND}): no SOURCES")
   endif()
   set(target penumbra-${KIND}-${NAME})
+  # One RUNPATH for the build and the install tree (BUILD_WITH_INSTALL_RPATH): a build RUNPATH that
+  # `cmake --install` rewrites is padded with ':', and an empty entry searches the current folder.
+  # In Penumbra's tree the core is two folders up from the plugins in both trees; outside it the
+  # core's absolute folder is added, as the plugin's build folder has no core beside it.
+  set(_rpath "$ORIGIN/../..")
+  if(NOT PENUMBRA_CORE_TARGET STREQUAL "penumbra-core")
+    get_target_property(_core_file ${PENUMBRA_CORE_TARGET} LOCATION)
+    get_filename_component(_core_dir "${_core_file}" DIRECTORY)
+    list(APPEND _rpath "${_core_dir}")
+  endif()
   add_library(${target} MODULE ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE ${PENUMBRA_CORE_TARGET} ${ARG_LIBRARIES})
   target_compile_features(${target} PRIVATE cxx_std_20)
@@ -27,8 +37,8 @@ function(penumbra_add_plugin NAME KIND)
     LIBRARY_OUTPUT_DIRECTORY ${PENUMBRA_PLUGIN_OUTPUT_DIRECTORY}
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON
-    BUILD_RPATH "$ORIGIN/../.."
-    INSTALL_RPATH "$ORIGIN/../..")
+    INSTALL_RPATH "${_rpath}"
+    BUILD_WITH_INSTALL_RPATH ON)
   foreach(alias IN LISTS ARG_ALIASES)
     add_custom_command(TARGET ${target} POST_BUILD
       COMMAND ${CMAKE_COMMAND} -E create_symlink ${target}.so

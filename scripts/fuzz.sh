@@ -18,7 +18,7 @@ targets=("$@")
 cxx="$(command -v clang++-14 || command -v clang++)"
 flags=(-std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
        -Icore/include -Icore/src -Itests -DPENUMBRA_SOURCE_DIR="\"$PWD\"")
-common=(core/src/util/error.cpp core/src/util/params.cpp)
+common=(core/src/util/error.cpp core/src/util/params.cpp core/src/util/input_file.cpp core/src/util/output_file.cpp)
 
 build_target() {
   case "$1" in

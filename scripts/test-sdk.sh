@@ -30,6 +30,19 @@ cmake -S "$tmp/example" -B "$tmp/example/build" "${generator[@]}" -DCMAKE_BUILD_
       -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/configure.log" 2>&1 || { cat "$tmp/configure.log"; fail "configure"; }
 cmake --build "$tmp/example/build" >"$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; fail "build"; }
 
+# No RUNPATH entry of the example plugin may be empty or relative (the loader would search the
+# current folder); tests/loading_test.cpp checks the tree's own binaries.
+runpath="$(readelf -d "$tmp/example/build/plugins/penumbra-integrator-ambientocclusion.so" |
+           sed -n 's/.*Library \(runpath\|rpath\): \[\(.*\)\]/\2/p')"
+[ -n "$runpath" ] || fail "the example plugin has no RUNPATH"
+case ":$runpath:" in
+  *::*) fail "the example plugin's RUNPATH '$runpath' has an empty entry" ;;
+esac
+IFS=: read -ra entries <<<"$runpath"
+for e in "${entries[@]}"; do
+  case "$e" in /*|'$ORIGIN'*) ;; *) fail "the example plugin's RUNPATH '$runpath' has the relative entry '$e'" ;; esac
+done
+
 penumbra="$prefix/bin/penumbra"
 export PENUMBRA_PLUGIN_PATH="$tmp/example/build/plugins"
 "$penumbra" plugins >"$tmp/plugins.txt" || fail "penumbra plugins reported errors"

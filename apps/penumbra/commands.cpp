@@ -1,5 +1,6 @@
 #include "commands.h"
 
+#include "image/image_io.h"
 #include "registry/registry.h"
 #include "render/merge.h"
 
@@ -41,7 +42,9 @@ int run_render(const RenderSettings& settings) {
 
 int run_merge(const std::vector<std::string>& parts, const std::string& output) {
   if (fs::path(output).extension() != ".exr")
-    throw Error(fmt::format("merge writes a multilayer EXR: the output '{}' must end in .exr", output));
+    throw Error(fmt::format("-o: merge writes a multilayer EXR: the output '{}' must end in .exr", output));
+  if (std::string problem = image_output_problem(output); !problem.empty())
+    throw Error(fmt::format("-o: {}", problem));
   MergeResult merged = merge_parts(parts);
   for (const auto& note : merged.notes) std::fprintf(stderr, "note: %s\n", note.c_str());
   write_layered_exr(output, merged.image);
@@ -56,7 +59,8 @@ int run_plugins(const std::vector<std::string>& dirs_in) {
   std::vector<LoadedPlugin> plugins = registry.load_all(&errors);
   std::printf("Plugin search path:\n");
   for (const auto& d : registry.search_dirs()) std::printf("  %s\n", d.c_str());
-  for (PluginKind kind : {PluginKind::Integrator, PluginKind::Sampler, PluginKind::Bsdf, PluginKind::Light}) {
+  for (PluginKind kind :
+       {PluginKind::Integrator, PluginKind::Sampler, PluginKind::Bsdf, PluginKind::Light, PluginKind::Texture}) {
     for (const LoadedPlugin& p : plugins) {
       const PluginInfo& info = *p.info;
       if (info.kind != kind) continue;

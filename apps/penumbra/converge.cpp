@@ -12,6 +12,7 @@
 
 #include "parser/scene_description.h"
 #include "render/scene_hash.h"
+#include "util/output_file.h"
 
 #include <cctype>
 #include <cmath>
@@ -19,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <algorithm>
 #include <map>
 
@@ -48,6 +50,7 @@ RenderSettings base_settings(const ConvergeSettings& s, const ConvergeConfig& co
   r.resolution = s.resolution;
   r.threads = s.threads;
   r.quiet = true;
+  r.image_written = false;  // snapshots and results go to the study folder, checked in run_converge
   return r;
 }
 
@@ -228,7 +231,12 @@ int run_converge(const ConvergeSettings& s) {
       ConvergeConfig ref = parse_configs(rc, "--reference-config").at(0);
       check_param_overrides(ref.integrator, ref.params);
     }
-  fs::create_directories(s.out_dir);
+  // The output folder is made and probed before any render, like every other output.
+  std::error_code dir_error;
+  fs::create_directories(s.out_dir, dir_error);
+  if (dir_error) throw Error(fmt::format("-o: cannot create the folder '{}': {}", s.out_dir, dir_error.message()));
+  if (std::string problem = output_path_problem((fs::path(s.out_dir) / "results.csv").string()); !problem.empty())
+    throw Error(fmt::format("-o: {}", problem));
 
   ImageRgb reference, variance;
   bool have_variance = false;
@@ -273,12 +281,13 @@ int run_converge(const ConvergeSettings& s) {
   }
 
   // Raw rows.
-  std::ofstream csv(fs::path(s.out_dir) / "results.csv");
+  std::ostringstream csv;
   csv << "config,run,snapshot,seconds,spp,rmse,relmse,mae,relmse_clamped,relse_median,worst_share\n";
   for (const Row& row : rows)
     csv << fmt::format("{},{},{},{:.6g},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", row.config, row.run,
                        row.snapshot, row.seconds, row.spp, row.errors.rmse, row.errors.rel_mse, row.errors.mae,
                        row.errors.rel_mse_clamped, row.errors.rel_se_median, row.errors.worst_share);
+  write_text_atomically((fs::path(s.out_dir) / "results.csv").string(), csv.str());
 
   // Per configuration and snapshot, over the runs: the median and interquartile range of every metric
   // (a heavy-tailed estimator's mean error is decided by its worst run); efficiency and the time to
@@ -379,7 +388,7 @@ int run_converge(const ConvergeSettings& s) {
       }
     }
   summary["ratios"] = ratios;
-  std::ofstream(fs::path(s.out_dir) / "summary.json") << summary.dump(2) << "\n";
+  write_text_atomically((fs::path(s.out_dir) / "summary.json").string(), summary.dump(2) + "\n");
   write_report((fs::path(s.out_dir) / "report.html").string(), summary, report_images);
   std::fprintf(stderr, "converge: wrote %s/results.csv, summary.json and report.html (%zu snapshots)\n", s.out_dir.c_str(), rows.size());
   return 0;

@@ -1,6 +1,7 @@
 #include "converge_report.h"
 
 #include "render/image_metrics.h"
+#include "util/output_file.h"
 
 #include <penumbra/error.h>
 
@@ -239,9 +240,7 @@ update();
 </script>
 )";
   h << "</body></html>\n";
-  std::ofstream out(path);
-  if (!out) throw Error(fmt::format("cannot write the report {}", path));
-  out << h.str();
+  write_text_atomically(path, h.str());
 }
 
 }  // namespace penumbra::cli

@@ -1,6 +1,7 @@
 #include "envmap_command.h"
 
 #include "environment_map.h"
+#include "image/image_io.h"
 
 #include <penumbra/error.h>
 #include <penumbra/image.h>
@@ -38,6 +39,8 @@ int run_envmap(const EnvmapSettings& s) {
   if (*to == envmap::Mapping::Equirectangular && s.size % 2 != 0)
     throw Error(fmt::format("--size {}: an equirectangular map is N x N/2, so N must be even", s.size));
 
+  if (std::string problem = image_output_problem(s.output); !problem.empty())
+    throw Error(fmt::format("output: {}", problem));
   ImageRgb in = read_image(s.input);
   if (in.width <= 0 || in.height <= 0) throw Error(fmt::format("{} is empty", s.input));
   for (float v : in.pixels)

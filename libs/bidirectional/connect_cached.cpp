@@ -1,5 +1,7 @@
 #include "connect_cached.h"
 
+#include <penumbra/memory.h>
+
 #include <penumbra/error.h>
 #include <penumbra/rng.h>
 
@@ -205,6 +207,10 @@ bool CachedConnector::prepare(const Context& ctx, const Sampler& proto, Point2i 
   auto cut = [&] { return stop && stop(); };
   auto t0 = std::chrono::steady_clock::now();
   M_ = opt_.light_paths ? opt_.light_paths : static_cast<size_t>(resolution.x) * resolution.y;
+  // The cache is the largest structure of a cached render: announced before it is allocated.
+  require_memory(cache_.estimated_bytes(M_), "bdpt's light-vertex cache",
+                 fmt::format("{} light paths of up to {} vertices, {} bytes each", M_, cache_.stride(),
+                             sizeof(Vertex)));
   // A pilot cache, independent of the render's samples.
   StreamSampler pilot(hash_ints(opt_.seed, 0x50434143u /* "PCAC" */));
   cache_.trace(ctx, pilot, resolution, 0xfffffffeu, M_, opt_.seed ^ 0x9e3779b97f4a7c15ull, stop);

@@ -46,6 +46,12 @@ class LightCache {
   const Vertex& vertex(size_t i) const { return vertices_[refs_[i].path * stride_ + refs_[i].vertex]; }
   std::span<const Vec3> positions() const { return positions_; }
   size_t memory_bytes() const;
+  /// Bytes trace() will hold for M paths: every slot of every path, plus, in the worst case where
+  /// every vertex can be connected to, its reference and position.
+  uint64_t estimated_bytes(size_t M) const {
+    return static_cast<uint64_t>(M) * (stride_ * (sizeof(Vertex) + sizeof(Ref) + sizeof(Vec3)) + sizeof(int));
+  }
+  size_t stride() const { return stride_; }
 
  private:
   size_t stride_;

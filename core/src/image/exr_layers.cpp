@@ -1,5 +1,8 @@
 #include "image/exr_layers.h"
 
+#include "util/input_file.h"
+#include "util/output_file.h"
+
 #include <penumbra/error.h>
 
 #include <OpenImageIO/imageio.h>
@@ -53,13 +56,19 @@ void write_layered_exr(const std::string& path, const LayeredImage& image) {
       for (size_t c = 0; c < n; ++c) buffer[p * names.size() + offset + c] = l.pixels[p * n + c];
     offset += n;
   }
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, OIIO::geterror()));
-  if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, buffer.data()) || !out->close())
-    throw Error(fmt::format("cannot write image '{}': {}", path, out->geterror()));
+  // Through a temporary file renamed into place: the old image survives a failure.
+  write_atomically(path, [&](const std::string& temporary) {
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, OIIO::geterror()));
+    if (!out->open(temporary, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, buffer.data()) || !out->close())
+      throw Error(fmt::format("cannot write image '{}': {}", path, out->geterror()));
+  });
 }
 
 LayeredImage read_layered_exr(const std::string& path) {
+  // Only regular files (util/input_file.h): a device or FIFO named as an image is refused, not read.
+  if (std::string problem = input_file_problem(path); !problem.empty())
+    throw Error(fmt::format("cannot read image '{}': {}", path, problem));
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();

@@ -46,6 +46,19 @@ AovSet parse_aovs(const std::vector<std::string>& lists, const FileLoc& loc) {
   return set;
 }
 
+uint64_t FilmAovs::bytes_per_pixel(const AovSet& set) {
+  uint64_t b = 0;
+  if (set.samples || set.variance || set.albedo || set.normal) b += sizeof(double);
+  if (set.samples || set.variance) b += sizeof(uint32_t);
+  if (set.variance) b += sizeof(Moments) + 3 * sizeof(float);
+  if (set.albedo) b += 3 * sizeof(double) + 3 * sizeof(float);
+  if (set.normal) b += 3 * sizeof(double) + 3 * sizeof(float);
+  if (set.depth) b += sizeof(float) + sizeof(float);
+  if (set.samples) b += 2 * sizeof(float);
+  if (set.nonfinite) b += sizeof(uint32_t) + sizeof(float);
+  return b;
+}
+
 FilmAovs::FilmAovs(Point2i resolution, AovSet set)
     : set_(set), pixels_(size_t(resolution.x) * size_t(resolution.y)) {
   if (set.samples || set.variance || set.albedo || set.normal) weight_.assign(pixels_, 0.0);

@@ -44,6 +44,8 @@ class FilmAovs {
   void load(StateReader& in);
   /// The requested layers, in the documented order.
   std::vector<ImageLayer> layers() const;
+  /// Bytes per pixel of the buffers for `set` plus the float layers made from them for the output.
+  static uint64_t bytes_per_pixel(const AovSet& set);
 
  private:
   struct Moments {  // West's weighted incremental mean and sum of squared deviations, per channel

@@ -1,5 +1,7 @@
 #include "image/film_rgb.h"
 
+#include <algorithm>
+
 #include "image/image_io.h"
 
 #include <penumbra/error.h>
@@ -106,6 +108,13 @@ FilterSample PixelFilter::sample(Vec2 u) const {
   float x = sample_axis(u.x, 0, &wx);
   float y = sample_axis(u.y, 1, &wy);
   return FilterSample{Vec2(x, y), wx * wy};
+}
+
+uint64_t FilmRgb::estimated_bytes(Point2i resolution, const AovSet& aovs) {
+  uint64_t pixels = static_cast<uint64_t>(std::max(resolution.x, 0)) * static_cast<uint64_t>(std::max(resolution.y, 0));
+  // Accumulator, the beauty image, and the writer's interleaved buffer of every float channel.
+  uint64_t per_pixel = sizeof(Pixel) + 3 * sizeof(float) + FilmAovs::bytes_per_pixel(aovs) + 3 * sizeof(float);
+  return pixels * per_pixel;
 }
 
 FilmRgb::FilmRgb(Point2i resolution, PixelFilter filter, AovSet aovs)

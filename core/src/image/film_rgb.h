@@ -46,6 +46,9 @@ struct ImageRgb;
 class FilmRgb final : public Film {
  public:
   FilmRgb(Point2i resolution, PixelFilter filter, AovSet aovs = {});
+  /// Bytes a film of `resolution` with `aovs` holds, plus the images made from it when the render
+  /// is written (the beauty, the AOV layers, one interleaved copy for the writer); without splats.
+  static uint64_t estimated_bytes(Point2i resolution, const AovSet& aovs);
   Point2i resolution() const override { return resolution_; }
   FilterSample sample_filter(Vec2 u) const override { return filter_.sample(u); }
   void add_sample(Point2i pixel, const Rgb& L, float weight) override;

@@ -1,5 +1,8 @@
 #include "image/image_io.h"
 
+#include "util/input_file.h"
+#include "util/output_file.h"
+
 #include <penumbra/error.h>
 
 #include <OpenColorIO/OpenColorIO.h>
@@ -48,6 +51,9 @@ const FormatInfo& format_of(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   for (const auto& f : kFormats)
     if (ext == f.extension) return f;
+  if (ext.empty())
+    throw Error(fmt::format("cannot write image '{}': it has no extension to choose the format by (supported: {})",
+                            path, supported_extensions()));
   throw Error(fmt::format("cannot write image '{}': unknown extension '{}' (supported: {})", path, ext,
                           supported_extensions()));
 }
@@ -133,16 +139,19 @@ std::vector<uint8_t> encode_for_display(const std::string& path, const ImageRgb&
 
 // ---- OpenImageIO ---------------------------------------------------------------------------------
 
+// Through a temporary file renamed into place (util/output_file.h): the old image survives a failure.
 void write_pixels(const std::string& path, const OIIO::ImageSpec& spec, const void* data) {
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, OIIO::geterror()));
-  if (!out->open(path, spec) || !out->write_image(spec.format, data) || !out->close())
-    throw Error(fmt::format("cannot write image '{}': {}", path, out->geterror()));
+  write_atomically(path, [&](const std::string& temporary) {
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, OIIO::geterror()));
+    if (!out->open(temporary, spec) || !out->write_image(spec.format, data) || !out->close())
+      throw Error(fmt::format("cannot write image '{}': {}", path, out->geterror()));
+  });
 }
 
 // OpenImageIO 2.4 reads PFM but cannot write it, and the format is a header plus raw floats.
-void write_pfm(const std::string& path, const ImageRgb& img) {
-  std::ofstream out(path, std::ios::binary);
+void write_pfm_to(const std::string& path, const std::string& temporary, const ImageRgb& img) {
+  std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
   // A negative scale marks little-endian data; rows run bottom to top.
   static_assert(std::endian::native == std::endian::little, "PFM writer assumes a little-endian host");
   out << "PF\n" << img.width << " " << img.height << "\n-1.0\n";
@@ -154,6 +163,10 @@ void write_pfm(const std::string& path, const ImageRgb& img) {
   if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, std::strerror(errno)));
 }
 
+void write_pfm(const std::string& path, const ImageRgb& img) {
+  write_atomically(path, [&](const std::string& temporary) { write_pfm_to(path, temporary, img); });
+}
+
 }  // namespace
 
 std::string ocio_config_path() {
@@ -163,6 +176,25 @@ std::string ocio_config_path() {
 }
 
 void check_ocio_config(const std::string& path) { load_config(path, false); }
+
+std::string image_output_problem(const std::string& path) {
+  try {
+    const FormatInfo& format = format_of(path);
+    std::string problem = output_path_problem(path);
+    if (!problem.empty()) return fmt::format("cannot write image '{}': {}", path, problem);
+    // 8-bit formats need a usable OpenColorIO config: find that out now, not after the render.
+    if (format.encoding == Encoding::Display) current_config();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool is_exr_path(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".exr";
+}
 
 void write_image(const std::string& path, const ImageRgb& img,
                  const std::vector<std::pair<std::string, std::string>>& metadata, const std::string& view) {
@@ -190,6 +222,9 @@ void write_image(const std::string& path, const ImageRgb& img,
 }
 
 ImageRgb read_image(const std::string& path, ImageFileInfo* info) {
+  // Only regular files (util/input_file.h): a device or FIFO named as an image is refused, not read.
+  if (std::string problem = input_file_problem(path); !problem.empty())
+    throw Error(fmt::format("cannot read image '{}': {}", path, problem));
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();

@@ -19,6 +19,13 @@ SplatBuffers::SplatBuffers(Point2i resolution)
       blocks_y_((resolution.y + kBlock - 1) / kBlock),
       id_(next_id.fetch_add(1)) {}
 
+uint64_t SplatBuffers::worst_case_bytes(Point2i resolution, int threads) {
+  uint64_t blocks = static_cast<uint64_t>((resolution.x + kBlock - 1) / kBlock) * ((resolution.y + kBlock - 1) / kBlock);
+  uint64_t pixels = static_cast<uint64_t>(resolution.x) * resolution.y;
+  return static_cast<uint64_t>(std::max(threads, 1)) * blocks * (sizeof(Block) + sizeof(std::unique_ptr<Block>)) +
+         pixels * 3 * sizeof(double);
+}
+
 // The calling thread's buffer: TBB's lookup by thread id once, then a thread-local cache (a splat
 // costs a comparison instead of a hash lookup).
 SplatBuffers::ThreadBuffer& SplatBuffers::local() {

@@ -19,6 +19,9 @@ namespace penumbra {
 class SplatBuffers {
  public:
   explicit SplatBuffers(Point2i resolution);
+  /// Bytes when each of `threads` threads splats into every block (what bidirectional integrators
+  /// reach): the blocks, each thread's block table, and the sums made for the image.
+  static uint64_t worst_case_bytes(Point2i resolution, int threads);
   /// Adds `v` at pixel (x, y), which must be inside the film. Returns false (and adds nothing) for
   /// a value too large for the fixed-point range (above 2^80 in magnitude) or not finite.
   bool add(int x, int y, const Rgb& v);

@@ -2,11 +2,11 @@
 // scene builder; the subset Penumbra supports is documented in docs/scene-format.md.
 #include "parser/scene_parser.h"
 
+#include "util/input_file.h"
+
 #include <fmt/core.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 namespace penumbra {
 
@@ -21,16 +21,6 @@ const std::set<std::string> kUnsupported = {
     "ObjectEnd",       "ObjectInstance", "TransformTimes",
 };
 
-bool read_whole_file(const fs::path& path, std::string& text) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return false;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  text = ss.str();
-  return true;
-}
 
 std::string closest_directive(const std::string& word, const std::vector<std::string>& names) {
   std::string best;
@@ -98,29 +88,60 @@ void SceneParser::dispatch(const Token& d) {
   std::vector<std::string> names;
   for (const auto& [name, handler] : handlers()) names.push_back(name);
   std::string best = closest_directive(d.text, names);
-  throw Error(d.loc, fmt::format("unknown directive '{}'{}", d.text,
+  throw Error(d.loc, fmt::format("unknown directive '{}'{}", shorten(d.text),
                                  best.empty() ? "" : fmt::format("; did you mean '{}'?", best)));
+}
+
+bool SceneParser::looks_like_directive(const Token& t) {
+  if (t.kind != TokenKind::Word) return false;
+  if (handlers().count(t.text) || kUnsupported.count(t.text)) return true;
+  std::vector<std::string> names;
+  for (const auto& [name, handler] : handlers()) names.push_back(name);
+  return !closest_directive(t.text, names).empty();
 }
 
 void SceneParser::parse_text(const std::string& text, const std::string& name,
                              const std::string& base_dir) {
-  Tokenizer tok(std::make_shared<const std::string>(text),
-                std::make_shared<const std::string>(name));
+  auto filename = std::make_shared<const std::string>(name);
+  Tokenizer tok(std::make_shared<const std::string>(text), filename);
   Tokenizer* outer_tok = tok_;
   std::string outer_dir = base_dir_;
   tok_ = &tok;
   base_dir_ = base_dir;
-  for (Token t = tok.next(); t.kind != TokenKind::End; t = tok.next()) dispatch(t);
+  // A file shows itself to be a scene file by its first token, a directive (or a near miss of one,
+  // which gets its did-you-mean). Until then nothing of its text reaches a message: a file that is
+  // not a scene (a key, a password list named by Include) must not be quoted to whoever reads the
+  // error. A file without tokens is an empty scene.
+  bool recognised = false, rejected = false;
+  try {
+    for (Token t = tok.next(); t.kind != TokenKind::End; t = tok.next()) {
+      if (!recognised && !looks_like_directive(t)) {
+        rejected = true;
+        break;
+      }
+      recognised = true;
+      dispatch(t);
+    }
+  } catch (const Error& e) {
+    if (recognised || e.loc().filename != filename) throw;
+    rejected = true;  // the first token could not even be read
+  }
+  if (rejected)
+    throw Error(FileLoc{filename, nullptr, 1, 1},
+                fmt::format("'{}' does not look like a pbrt-v4 scene file: it does not begin with a directive "
+                            "(its text is not quoted)",
+                            name));
   tok_ = outer_tok;
   base_dir_ = outer_dir;
 }
 
 void SceneParser::parse_file(const fs::path& path, const FileLoc& included_from) {
-  std::string text;
-  if (!read_whole_file(path, text)) {
-    const char* what = included_from.filename ? "included file" : "scene file";
+  const char* what = included_from.filename ? "included file" : "scene file";
+  std::error_code exists_error;
+  if (!fs::exists(path, exists_error))
     throw Error(included_from, fmt::format("cannot open {} '{}'", what, path.string()));
-  }
+  // Only regular files, read up to their size (util/input_file.h): not /dev/zero, not a FIFO.
+  std::string text = read_input_file(path.string(), what, included_from);
   std::error_code ec;
   std::string key = fs::weakly_canonical(path, ec).string();
   if (ec) key = path.lexically_normal().string();
@@ -198,6 +219,7 @@ void SceneParser::world_begin(const Token& d) {
     throw Error(d.loc, fmt::format("WorldBegin given twice (first at {})", world_begin_loc_.str()));
   in_world_ = true;
   world_begin_loc_ = d.loc;
+  desc_.world_begin = d.loc;
   state_.ctm = glm::dmat4(1.0);
   named_coordinate_systems_["world"] = state_.ctm;
 }

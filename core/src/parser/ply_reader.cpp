@@ -3,6 +3,8 @@
 // (vertices with positions, normals and uvs; polygon faces) fits in this file.
 #include "parser/ply_reader.h"
 
+#include "util/input_file.h"
+
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -10,10 +12,10 @@
 #include <cctype>
 #include <charconv>
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 namespace penumbra {
@@ -282,9 +284,41 @@ void add_polygon(const std::vector<int>& poly, std::vector<int>& indices) {
     indices.insert(indices.end(), {poly[0], poly[k], poly[k + 1]});
 }
 
-void read_faces(const Element& e, DataReader& in, TriangleMeshData& mesh, const Context& ctx) {
+// The value of integer `v` of type `t` with its bytes in the other order.
+double byte_swapped(Scalar t, double v) {
+  unsigned char b[8];
+  auto swap = [&](auto x) {
+    std::memcpy(b, &x, sizeof x);
+    std::reverse(b, b + sizeof x);
+    std::memcpy(&x, b, sizeof x);
+    return static_cast<double>(x);
+  };
+  switch (t) {
+    case Scalar::Int16: return swap(static_cast<int16_t>(v));
+    case Scalar::UInt16: return swap(static_cast<uint16_t>(v));
+    case Scalar::Int32: return swap(static_cast<int32_t>(v));
+    case Scalar::UInt32: return swap(static_cast<uint32_t>(v));
+    default: return v;  // one byte, or not an integer type
+  }
+}
+
+// For a bad vertex index in a binary file: whether the other byte order would have made it a good
+// one, the signature of a file whose header names the wrong endianness.
+std::string endianness_hint(Format format, Scalar t, double value, size_t vertex_count) {
+  if (format == Format::Ascii || size_of(t) == 1 || value != std::floor(value)) return "";
+  double other = byte_swapped(t, value);
+  if (other < 0 || other >= static_cast<double>(vertex_count)) return "";
+  return fmt::format("; read in the other byte order it would be {}, a valid index: the header says {}, but the "
+                     "data look {} (was the file written with the wrong endianness?)",
+                     other, format == Format::BinaryLittleEndian ? "binary_little_endian" : "binary_big_endian",
+                     format == Format::BinaryLittleEndian ? "big-endian" : "little-endian");
+}
+
+// Returns the type of the index list, for check_mesh()'s endianness hint.
+Scalar read_faces(const Element& e, DataReader& in, TriangleMeshData& mesh, Format format, const Context& ctx) {
   int list = find_index_list(e);
   if (list < 0) ctx.fail("the face element has no vertex_indices list");
+  size_t vertices = mesh.P.empty() ? SIZE_MAX : mesh.P.size();  // known when the vertices came first
   std::vector<int> poly;
   for (size_t i = 0; i < e.count; ++i) {
     for (size_t k = 0; k < e.props.size(); ++k) {
@@ -297,7 +331,8 @@ void read_faces(const Element& e, DataReader& in, TriangleMeshData& mesh, const 
       for (int& idx : poly) {
         double d = in.read(p.type);
         if (d < 0 || d > INT_MAX)
-          ctx.fail(fmt::format("vertex index {} out of range in face {}", d, i));
+          ctx.fail(fmt::format("vertex index {} out of range in face {}{}", d, i,
+                               endianness_hint(format, p.type, d, vertices)));
         if (d != static_cast<double>(static_cast<long long>(d)))
           ctx.fail(fmt::format("vertex index {} in face {} is not an integer", d, i));
         idx = static_cast<int>(d);
@@ -305,26 +340,32 @@ void read_faces(const Element& e, DataReader& in, TriangleMeshData& mesh, const 
       add_polygon(poly, mesh.indices);  // faces with fewer than 3 vertices add nothing
     }
   }
+  return e.props[list].type;
 }
 
-void check_mesh(const TriangleMeshData& mesh, bool has_vertices, const Context& ctx) {
+void check_mesh(const TriangleMeshData& mesh, bool has_vertices, Format format, Scalar index_type,
+                const Context& ctx) {
   if (!has_vertices) ctx.fail("no vertex element with x, y and z properties");
   if (mesh.P.empty()) ctx.fail("the mesh has no vertices");
   if (mesh.indices.empty()) ctx.fail("the mesh has no faces");
   for (int idx : mesh.indices)
     if (idx < 0 || static_cast<size_t>(idx) >= mesh.P.size())
-      ctx.fail(fmt::format("vertex index {} out of range (the mesh has {} vertices)", idx,
-                           mesh.P.size()));
+      ctx.fail(fmt::format("vertex index {} out of range (the mesh has {} vertices){}", idx, mesh.P.size(),
+                           endianness_hint(format, index_type, idx, mesh.P.size())));
 }
 
+// Only regular files, read up to their size (util/input_file.h): a link to /dev/zero or a FIFO
+// is refused instead of read forever.
 std::string read_file_bytes(const std::string& path, const Context& ctx) {
   std::error_code ec;
-  std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path, ec) || !in) ctx.fail("cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) ctx.fail("cannot read the file");
-  return ss.str();
+  if (!std::filesystem::exists(path, ec)) ctx.fail("cannot open the file");
+  std::string problem = input_file_problem(path);
+  if (!problem.empty()) ctx.fail(fmt::format("cannot open the file: {}", problem));
+  try {
+    return read_input_file(path, "the file");
+  } catch (const Error& e) {
+    ctx.fail(e.what());
+  }
 }
 
 }  // namespace
@@ -333,22 +374,29 @@ TriangleMeshData read_ply(const std::string& path, const FileLoc& loc) {
   Context ctx{path, loc};
   std::string data = read_file_bytes(path, ctx);
   Header h = parse_header(data, ctx);
+  // Every item of an element with properties takes at least a byte: a count beyond the data is a
+  // corrupt header, refused before a loop of that many reads (or a reservation) starts.
+  for (const Element& e : h.elements)
+    if (e.count > data.size() - h.data_start)
+      ctx.fail(fmt::format("the header declares {} '{}' items, more than the {} bytes after the header can hold",
+                           e.count, e.name, data.size() - h.data_start));
   DataReader in(data, h.data_start, h.format, ctx);
   TriangleMeshData mesh;
   bool has_vertices = false;
+  Scalar index_type = Scalar::Int32;
   for (const Element& e : h.elements) {
     bool positions = e.find({"x"}) >= 0 && e.find({"y"}) >= 0 && e.find({"z"}) >= 0;
     if (e.name == "vertex" && positions && !has_vertices) {
       read_vertices(e, in, mesh, data.size());
       has_vertices = true;
     } else if (e.name == "face") {
-      read_faces(e, in, mesh, ctx);
+      index_type = read_faces(e, in, mesh, h.format, ctx);
     } else {
       for (size_t i = 0; i < e.count; ++i)
         for (const Property& p : e.props) in.skip(p);
     }
   }
-  check_mesh(mesh, has_vertices, ctx);
+  check_mesh(mesh, has_vertices, h.format, index_type, ctx);
   return mesh;
 }
 

@@ -49,6 +49,7 @@ struct SceneDescription {
   std::vector<SceneEntity> lights;                // LightSource
   std::vector<SceneEntity> area_lights;           // AreaLightSource
   std::vector<ShapeEntity> shapes;
+  FileLoc world_begin;   // where WorldBegin is; no filename when the scene has none
 };
 
 /// Parses a pbrt-v4 scene file (following Include and Import). Throws Error with a location.

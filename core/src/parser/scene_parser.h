@@ -40,6 +40,7 @@ class SceneParser {
  private:
   using Handler = void (SceneParser::*)(const Token&);
   void dispatch(const Token& directive);
+  static bool looks_like_directive(const Token& first);
   static const std::map<std::string, Handler>& handlers();
 
   // Reading arguments.

@@ -32,7 +32,10 @@ std::string describe_char(char c) {
 
 Tokenizer::Tokenizer(std::shared_ptr<const std::string> text,
                      std::shared_ptr<const std::string> filename)
-    : text_(std::move(text)), filename_(std::move(filename)) {}
+    : text_(std::move(text)), filename_(std::move(filename)) {
+  // A UTF-8 byte-order mark (editors on Windows write one) is skipped; columns count after it.
+  if (text_->compare(0, 3, "\xEF\xBB\xBF") == 0) pos_ = 3;
+}
 
 FileLoc Tokenizer::here() const { return FileLoc{filename_, text_, line_, column_}; }
 
@@ -136,11 +139,18 @@ Token Tokenizer::scan_string() {
   return t;
 }
 
+std::string shorten(const std::string& text, size_t max) {
+  if (text.size() <= max) return text;
+  size_t cut = max;
+  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;  // whole UTF-8 characters
+  return fmt::format("{}... ({} bytes)", text.substr(0, cut), text.size());
+}
+
 std::string describe(const Token& t) {
   switch (t.kind) {
-    case TokenKind::String: return fmt::format("string \"{}\"", t.text);
+    case TokenKind::String: return fmt::format("string \"{}\"", shorten(t.text));
     case TokenKind::End: return "end of file";
-    default: return fmt::format("'{}'", t.text);
+    default: return fmt::format("'{}'", shorten(t.text));
   }
 }
 
@@ -154,7 +164,7 @@ double parse_number(const Token& t) {
   double v = 0.0;
   auto [end, ec] = std::from_chars(first, last, v);
   if (ec != std::errc() || end != last || first == last || !std::isfinite(v))
-    throw Error(t.loc, fmt::format("bad number '{}'", t.text));
+    throw Error(t.loc, fmt::format("bad number '{}'", shorten(t.text)));
   return v;
 }
 

@@ -53,8 +53,11 @@ class Tokenizer {
   Token peeked_;
 };
 
-/// How a token reads in a message: "'Foo'", "string \"abc\"", "end of file".
+/// How a token reads in a message: "'Foo'", "string \"abc\"", "end of file" (long texts shortened).
 std::string describe(const Token& t);
+
+/// `text` for a message: up to `max` bytes, then "... (N bytes)".
+std::string shorten(const std::string& text, size_t max = 60);
 
 /// The value of a Number token (std::from_chars, so no locale); a malformed or non-finite number is
 /// an Error at the token.

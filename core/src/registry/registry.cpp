@@ -1,5 +1,7 @@
 #include "registry/registry.h"
 
+#include "registry/elf_check.h"
+
 #include <fmt/core.h>
 
 #include <dlfcn.h>
@@ -24,7 +26,15 @@ const char* plugin_kind_name(PluginKind kind) {
   return "unknown";
 }
 
-Registry::Registry(std::vector<std::string> dirs) : dirs_(std::move(dirs)) {}
+// Folders are made absolute once, so a plugin path always names its folder and dlopen() never
+// searches the library path or depends on a later change of the current folder.
+Registry::Registry(std::vector<std::string> dirs) {
+  for (const std::string& d : dirs) {
+    std::error_code ec;
+    fs::path abs = fs::absolute(d, ec);
+    dirs_.push_back(ec ? d : abs.lexically_normal().string());
+  }
+}
 
 std::vector<std::string> Registry::default_search_dirs() {
   std::vector<std::string> dirs;
@@ -37,7 +47,17 @@ std::vector<std::string> Registry::default_search_dirs() {
     while (start <= s.size()) {
       size_t end = s.find(':', start);
       if (end == std::string::npos) end = s.size();
-      if (end > start) dirs.push_back(s.substr(start, end - start));
+      std::string dir = s.substr(start, end - start);
+      // Empty entries are skipped (not "the current folder", as in $PATH), and relative ones too:
+      // they would load whatever plugin the folder a render happens to start in holds.
+      if (!dir.empty() && fs::path(dir).is_relative()) {
+        static bool warned = false;
+        if (!warned)
+          warning({}, fmt::format("$PENUMBRA_PLUGIN_PATH entry '{}' is not an absolute path and is ignored", dir));
+        warned = true;
+      } else if (!dir.empty()) {
+        dirs.push_back(dir);
+      }
       start = end + 1;
     }
   }
@@ -77,6 +97,9 @@ const LoadedPlugin& Registry::open(const std::string& path, const FileLoc& loc) 
   std::string key = fs::weakly_canonical(path, ec).string();
   if (auto it = by_path_.find(key); it != by_path_.end()) return it->second;
 
+  // A truncated or corrupt file would crash the dynamic loader (SIGBUS): its headers are checked first.
+  if (std::string problem = elf_file_problem(path); !problem.empty())
+    throw Error(loc, fmt::format("plugin {} cannot be loaded: {}; rebuild or reinstall it", path, problem));
   // Libraries stay open for the life of the process: objects they created may outlive the registry.
   void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw Error(loc, fmt::format("cannot open plugin {}: {}", path, dlerror()));

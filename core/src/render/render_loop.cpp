@@ -4,14 +4,18 @@
 // bit whatever the thread count, and a part of a split render (indices [first_sample, first_sample +
 // spp)) takes exactly its share of them. Splats go to the film's per-thread fixed-point buffers,
 // whose integer sums do not depend on the order of the additions.
+#include "image/splat_buffers.h"
 #include "render/checkpoint.h"
 #include "render/surface_sample.h"
 
 #include <penumbra/integrator.h>
+#include <penumbra/memory.h>
 
+#include <fmt/core.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -67,6 +71,13 @@ void SampleIntegrator::render(RenderContext& ctx) {
   // Asked after begin_render(), since they may depend on what it set up.
   const bool to_film = film_holds_estimate();
   const int max_pass = std::max(1, max_pass_samples());
+  // Splats from every thread may reach every pixel (bidirectional integrators do): their buffers'
+  // worst case is announced before the first sample. Integrators along the camera ray never splat.
+  if (to_film && !dynamic_cast<const PixelIntegrator*>(this)) {
+    int threads = opt.threads > 0 ? opt.threads : tbb::this_task_arena::max_concurrency();
+    require_memory(SplatBuffers::worst_case_bytes(res, threads), "the film's splat buffers",
+                   fmt::format("{}x{} pixels, 48 bytes each for each of {} threads", res.x, res.y, threads));
+  }
 
   tbb::enumerable_thread_specific<ThreadState> threads(
       [&] { return ThreadState{ctx.sampler().clone(), CheckedSplats(ctx, film)}; });

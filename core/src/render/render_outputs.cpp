@@ -1,28 +1,53 @@
 #include "render/render_outputs.h"
 
 #include "image/film_aovs.h"
+#include "image/image_io.h"
+#include "util/output_file.h"
 
 #include <penumbra/version.h>
 
 #include <fmt/core.h>
 
-#include <algorithm>
-#include <cctype>
 #include <cstdint>
-#include <filesystem>
 #include <regex>
 
 namespace penumbra {
 
 namespace {
 
-bool is_exr(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".exr";
+// The image a render writes and who named it, for messages: "-o" or the scene's Film "filename".
+struct ImageOutput {
+  std::string path;
+  std::string option;  // "-o", or "" when the scene (or the default) chose it
+  FileLoc loc;         // the Film's "filename" parameter, when the scene chose it
+};
+
+ImageOutput image_output(const RenderSettings& settings, const SceneDescription& desc) {
+  if (!settings.output.empty()) return {settings.output, "-o", {}};
+  const Param* f = desc.film.params.find("filename");
+  if (f && !f->strings.empty()) return {f->strings[0], "", f->loc};
+  return {kDefaultOutput, "", {}};
+}
+
+Error output_error(const ImageOutput& out, const std::string& message) {
+  if (!out.option.empty()) return Error(fmt::format("{}: {}", out.option, message));
+  if (out.loc.filename) return Error(out.loc, message);
+  return Error(fmt::format("the default output {}: {}", out.path, message));
 }
 
 }  // namespace
+
+void check_command_line_outputs(const RenderSettings& settings) {
+  if (!settings.output.empty()) {
+    std::string problem = image_output_problem(settings.output);
+    if (!problem.empty()) throw Error(fmt::format("-o: {}", problem));
+  }
+  if (!settings.stats_file.empty()) {
+    std::string problem = output_path_problem(settings.stats_file);
+    if (!problem.empty())
+      throw Error(fmt::format("--stats: cannot write '{}': {}", settings.stats_file, problem));
+  }
+}
 
 SampleRange apply_output_settings(const RenderSettings& settings, SceneDescription& desc) {
   SampleRange range;
@@ -55,16 +80,15 @@ SampleRange apply_output_settings(const RenderSettings& settings, SceneDescripti
   AovSet set = parse_aovs(aovs, loc);
   if (set.any()) desc.film.params.set_string("aovs", set.names());
 
-  std::string output = settings.output;
-  if (output.empty()) {
-    const Param* f = desc.film.params.find("filename");
-    output = f && !f->strings.empty() ? f->strings[0] : "penumbra.exr";
-  }
-  if (range.split && !is_exr(output))
-    throw Error(fmt::format("a part of a split render must be written as .exr (for `penumbra merge`), not '{}'",
-                            output));
-  if (set.any() && !is_exr(output))
-    throw Error(fmt::format("AOVs ({}) are written as EXR layers: the output '{}' must be .exr", set.names(), output));
+  ImageOutput out = image_output(settings, desc);
+  std::string problem = settings.image_written ? image_output_problem(out.path) : "";
+  if (!problem.empty()) throw output_error(out, problem);
+  if (range.split && !is_exr_path(out.path))
+    throw output_error(out, fmt::format("a part of a split render must be written as .exr (for `penumbra merge`), "
+                                        "not '{}'", out.path));
+  if (set.any() && !is_exr_path(out.path))
+    throw output_error(out, fmt::format("AOVs ({}) are written as EXR layers: the output '{}' must be .exr",
+                                        set.names(), out.path));
   return range;
 }
 

@@ -18,10 +18,20 @@ struct SampleRange {
   bool split = false;  // --spp-total was given
 };
 
-/// Checks the split and AOV options against each other and the output file, then writes them into
-/// the description: pixelsamples becomes the total (so samplers that depend on it agree between
+/// The image written when neither -o nor the Film's "filename" names one.
+inline constexpr const char* kDefaultOutput = "penumbra.exr";
+
+/// Checks the files named on the command line (-o, --stats) before the scene is even read: the
+/// folder exists and accepts new files, the image extension is known (and an 8-bit format has its
+/// OpenColorIO config). Throws Error naming the option.
+void check_command_line_outputs(const RenderSettings& settings);
+
+/// Checks the split and AOV options against each other and the output image (the one of -o, the
+/// Film's "filename" or the default: writable, known extension, EXR when it must hold AOV layers or
+/// a split part; an error names -o or the scene's file:line:col), then writes them into the
+/// description: pixelsamples becomes the total (so samplers that depend on it agree between
 /// parts) and the Film's "aovs" gains --aov and, for a part, "samples" (which `penumbra merge`
-/// needs). Throws Error.
+/// needs). Throws Error before anything is built or rendered.
 SampleRange apply_output_settings(const RenderSettings& settings, SceneDescription& desc);
 
 /// Half-open index ranges as "0-16,32-48"; parse_ranges() throws Error for malformed text.

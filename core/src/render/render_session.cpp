@@ -8,7 +8,9 @@
 #include "render/ray_counter.h"
 #include "render/render_outputs.h"
 #include "render/scene_hash.h"
+#include "render/scene_warnings.h"
 #include "scene/scene_builder.h"
+#include "util/output_file.h"
 
 
 #include <fmt/core.h>
@@ -26,7 +28,6 @@
 #include <climits>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <mutex>
 
@@ -343,6 +344,7 @@ void check_param_overrides(const std::string& integrator, const std::vector<Para
 RenderResult render(const RenderSettings& settings) {
   auto t0 = Clock::now();
   size_t rays_before = total_rays();
+  check_command_line_outputs(settings);
   SceneDescription desc = parse_scene_file(settings.scene_file);
   Registry registry(settings.plugin_dirs.empty() ? Registry::default_search_dirs() : settings.plugin_dirs);
 
@@ -388,6 +390,7 @@ RenderResult render(const RenderSettings& settings) {
         throw Error(fmt::format("{}: {}", *p.loc.filename, e.what()));
     throw;
   }
+  report_silent_results(silent_result_warnings(desc, built), settings.strict);
   built.film->set_firefly_threshold(settings.firefly_threshold);
   RenderOptions options;
   options.time_budget = settings.time_budget;
@@ -515,11 +518,7 @@ std::string stats_json(const RenderStats& s) {
 void write_outputs(const RenderSettings& settings, const RenderResult& result) {
   const RenderStats& s = result.stats;
   write_render_image(result);
-  if (!settings.stats_file.empty()) {
-    std::ofstream out(settings.stats_file);
-    if (!out) throw Error(fmt::format("cannot write stats file {}", settings.stats_file));
-    out << stats_json(s);
-  }
+  if (!settings.stats_file.empty()) write_text_atomically(settings.stats_file, stats_json(s));
 }
 
 }  // namespace penumbra

@@ -51,7 +51,9 @@ struct RenderSettings {
   std::vector<ParamOverride> integrator_params;  // --param NAME=VALUE, applied after --integrator
   std::optional<std::pair<int, int>> resolution;  // --res WxH
   std::string stats_file;                // --stats FILE.json
+  bool image_written = true;             // false: the caller keeps the image (converge); its path is not checked
   bool quiet = false;                    // no progress output
+  bool strict = false;                   // --strict: scenes that render black (render/scene_warnings.h) are errors
   float firefly_threshold = 1000.f;      // samples brighter than this (max component) are counted
   std::vector<std::string> plugin_dirs;  // default: Registry::default_search_dirs()
   /// Snapshots for convergence studies: after the first complete pass at or past each of these

@@ -1,9 +1,12 @@
 #include "render/scene_hash.h"
 
+#include "util/input_file.h"
+
 #include <penumbra/rng.h>
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -33,10 +36,18 @@ class Hasher {
 };
 
 void hash_file(Hasher& h, const fs::path& path) {
+  // Missing and non-regular files (a link to /dev/zero, a FIFO) are left to the builder to report;
+  // the name is hashed anyway. A regular file is read up to the size it has now.
+  if (!input_file_problem(path.string()).empty()) return;
+  std::error_code ec;
+  uintmax_t left = fs::file_size(path, ec);
   std::ifstream in(path, std::ios::binary);
-  if (!in) return;  // the builder reports missing files; the name is hashed anyway
+  if (ec || !in) return;
   char buf[1 << 16];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) h.bytes(buf, size_t(in.gcount()));
+  while (left > 0 && (in.read(buf, std::streamsize(std::min<uintmax_t>(sizeof buf, left))) || in.gcount() > 0)) {
+    h.bytes(buf, size_t(in.gcount()));
+    left -= uintmax_t(in.gcount());
+  }
 }
 
 void hash_entity(Hasher& h, const SceneEntity& e, bool is_film) {

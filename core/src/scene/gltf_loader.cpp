@@ -1,5 +1,7 @@
 #include "scene/gltf_loader.h"
 
+#include "util/input_file.h"
+
 #include <fmt/core.h>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -12,6 +14,19 @@
 namespace penumbra {
 
 namespace {
+
+// Buffers and images a glTF file names are read as every other input is: only regular files, up to
+// their size (util/input_file.h).
+bool read_regular_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+  try {
+    std::string bytes = read_input_file(path, "glTF buffer");
+    out->assign(bytes.begin(), bytes.end());
+    return true;
+  } catch (const Error& e) {
+    if (err) *err += std::string(e.what()) + "\n";
+    return false;
+  }
+}
 
 // Textures are not supported yet: accept image entries without decoding them.
 bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
@@ -98,13 +113,19 @@ glm::dmat4 node_transform(const tinygltf::Node& node) {
 
 std::vector<GltfPrimitive> load_gltf(const std::string& path, const FileLoc& loc) {
   if (!std::filesystem::exists(path)) throw Error(loc, fmt::format("glTF file '{}' does not exist", path));
+  std::string bytes = read_input_file(path, "glTF file", loc);
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skip_image, nullptr);
+  loader.SetFsCallbacks(tinygltf::FsCallbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_regular_file,
+                                              &tinygltf::WriteWholeFile, nullptr});
   tinygltf::Model model;
   std::string err, warn;
   bool binary = std::filesystem::path(path).extension() == ".glb";
-  bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                   : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  std::string base_dir = std::filesystem::path(path).parent_path().string();
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned>(bytes.size()), base_dir)
+                   : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()),
+                                                base_dir);
   if (!ok) throw Error(loc, fmt::format("glTF file '{}' cannot be read: {}", path, err.empty() ? warn : err));
   Reader reader(model, path, loc);
   if (!model.textures.empty())

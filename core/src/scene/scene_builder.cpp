@@ -6,6 +6,8 @@
 #include "scene/orthographic_camera.h"
 #include "scene/perspective_camera.h"
 
+#include <penumbra/memory.h>
+
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -209,6 +211,15 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     throw Error(desc.film.loc, fmt::format("unsupported film '{}'; available: rgb", desc.film.type));
   desc.film.params.validate(film_rgb_params(), "film 'rgb'");
   Point2i res(desc.film.params.get_int("xresolution"), desc.film.params.get_int("yresolution"));
+  const Param* aovs = desc.film.params.find("aovs");
+  AovSet aov_set = aovs ? parse_aovs(aovs->strings, aovs->loc) : AovSet{};
+  // Announced before the film is allocated, and before the size limit below, so that an absurd
+  // resolution says what it would cost (penumbra/memory.h).
+  uint64_t film_bytes = FilmRgb::estimated_bytes(res, aov_set);
+  if (film_bytes > 0)
+    require_memory(film_bytes, fmt::format("the {}x{} film", res.x, res.y),
+                   fmt::format("{} bytes per pixel{}", film_bytes / (uint64_t(res.x) * uint64_t(res.y)),
+                               aov_set.any() ? fmt::format(" with the AOVs {}", aov_set.names()) : ""));
   if (res.x <= 0 || res.y <= 0 || res.x > 65536 || res.y > 65536)
     throw Error(desc.film.loc, fmt::format("film resolution {}x{} is out of range", res.x, res.y));
   out.output_filename = desc.film.params.get_string("filename");
@@ -218,8 +229,6 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     throw Error(desc.filter.loc,
                 fmt::format("unsupported pixel filter '{}'; available: box, gaussian, triangle", filter_type));
   desc.filter.params.validate(pixel_filter_params(filter_type), fmt::format("filter '{}'", filter_type));
-  const Param* aovs = desc.film.params.find("aovs");
-  AovSet aov_set = aovs ? parse_aovs(aovs->strings, aovs->loc) : AovSet{};
   out.film = std::make_unique<FilmRgb>(res, PixelFilter(filter_type, desc.filter.params, desc.filter.loc), aov_set);
 
   std::unique_ptr<Camera> camera;

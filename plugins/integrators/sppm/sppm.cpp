@@ -36,8 +36,10 @@
 #include "visible_point_grid.h"
 
 #include <penumbra/integrator.h>
+#include <penumbra/memory.h>
 #include <penumbra/plugin.h>
 
+#include <fmt/core.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -155,6 +157,14 @@ void SppmIntegrator::begin_render(RenderContext& ctx) {
   // One bounce is all direct light; photons start to matter from two.
   trace_photons_ = max_depth_ >= 2 && photons_ > 0 && total_power > 0.0;
   rays_find_lights_ = rays_can_find_lights(scene);
+  // Per-pixel state, announced before it is allocated: the visible point and its split-out position,
+  // radius and direct light, the statistics, the photon accumulator, the footprint, one gather point
+  // and, per point in the grid, a 16-byte entry, its index, its bucket and up to 8 bytes of bucket table.
+  const uint64_t per_pixel = sizeof(VisiblePoint) + sizeof(Vec3) + sizeof(float) + sizeof(Rgb) +
+                             sizeof(PixelStatistics) + sizeof(PhotonAccumulator) + sizeof(float) +
+                             sizeof(GatherPoint) + 16 + 4 + 4 + 8;
+  require_memory(n_pixels * per_pixel, "sppm's per-pixel statistics",
+                 fmt::format("{} pixels, {} bytes each", n_pixels, per_pixel));
   vps_.assign(n_pixels, VisiblePoint{});
   vp_p_.assign(n_pixels, Vec3(0.f));
   vp_radius_.assign(n_pixels, 0.f);
