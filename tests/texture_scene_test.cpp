@@ -133,7 +133,8 @@ Shape "trianglemesh" "point3 P" [ -2 -2 0  2 -2 0  2 2 0  -2 2 0 ] "integer indi
 }
 
 // Textured BSDF parameters are looked up at the hit: a checkerboard reflectance gives f = R / pi of
-// the square the uv falls in, and a roughness texture gives the conductor the lobe of that value.
+// the square the uv falls in, and a roughness texture gives the conductor the lobe of that value;
+// diffusetransmission takes a textured reflectance next to a constant transmittance.
 TEST(TextureScene, BsdfParametersFollowTheirTextures) {
   Registry registry(Registry::default_search_dirs());
   SceneDescription d = parse_scene_string(std::string("WorldBegin\n") + kRough +
@@ -141,6 +142,7 @@ TEST(TextureScene, BsdfParametersFollowTheirTextures) {
 Material "diffuse" "texture reflectance" "c"
 Material "conductor" "texture roughness" "rough"
 Material "conductor" "float roughness" [ 0.2 ]
+Material "diffusetransmission" "texture reflectance" "c" "rgb transmittance" [ 0.6 0.5 0.4 ] "float scale" [ 0.5 ]
 )",
                                           "b.pbrt");
   BuiltScene b = build_scene(d, registry);
@@ -153,6 +155,14 @@ Material "conductor" "float roughness" [ 0.2 ]
   Rgb textured = b.bsdfs[1]->f(wo, wi, ctx), constant = b.bsdfs[2]->f(wo, wi, ctx);
   EXPECT_NEAR(textured.r, constant.r, 1e-6f * constant.r);
   EXPECT_NEAR(b.bsdfs[1]->pdf(wo, wi, ctx), b.bsdfs[2]->pdf(wo, wi, ctx), 1e-6f);
+  // diffusetransmission: the textured reflectance on wo's side, the constant transmittance through,
+  // both scaled by 0.5.
+  ctx.tex.uv = Vec2(0.5f, 0.5f);
+  EXPECT_NEAR(b.bsdfs[3]->f(wo, wi, ctx).r, 0.5f * 0.8f * InvPi, 1e-6f);
+  EXPECT_NEAR(b.bsdfs[3]->f(wo, -wi, ctx).b, 0.5f * 0.4f * InvPi, 1e-6f);
+  ctx.tex.uv = Vec2(1.5f, 0.5f);
+  EXPECT_NEAR(b.bsdfs[3]->f(wo, wi, ctx).g, 0.5f * 0.1f * InvPi, 1e-6f);
+  EXPECT_NEAR(b.bsdfs[3]->f(wo, -wi, ctx).g, 0.5f * 0.5f * InvPi, 1e-6f);
 }
 
 namespace {

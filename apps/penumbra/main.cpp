@@ -34,12 +34,11 @@ std::pair<int, int> parse_resolution(const std::string& text) {
 
 // pbrt renders `pbrt [options] scene.pbrt`: without a subcommand (and with arguments that are not
 // --help or --version), `render` is meant.
-std::vector<std::string> arguments_with_subcommand(int argc, char** argv) {
+std::vector<std::string> arguments_with_subcommand(const CLI::App& app, int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  static const char* const kKnown[] = {"render", "merge", "plugins", "converge", "--help", "-h", "--version"};
-  if (args.empty()) return args;
-  for (const char* k : kKnown)
-    if (args[0] == k) return args;
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "--version") return args;
+  auto named = app.get_subcommands([&](const CLI::App* sub) { return sub->check_name(args[0]); });
+  if (!named.empty()) return args;
   args.insert(args.begin(), "render");
   return args;
 }
@@ -136,7 +135,7 @@ int main(int argc, char** argv) {
   plugins->add_option("--dir", plugin_dirs, "search these folders instead of the default path");
 
   try {
-    std::vector<std::string> args = arguments_with_subcommand(argc, argv);
+    std::vector<std::string> args = arguments_with_subcommand(app, argc, argv);
     std::reverse(args.begin(), args.end());  // CLI11 takes the arguments last first
     app.parse(args);
   } catch (const CLI::CallForHelp& e) {

@@ -5,11 +5,12 @@
 //
 // | parameter         | default        | meaning                                          |
 // |-------------------|----------------|--------------------------------------------------|
-// | rgb reflectance   | 0.25 0.25 0.25 | diffuse reflectance                              |
-// | rgb transmittance | 0.25 0.25 0.25 | diffuse transmittance                            |
+// | rgb reflectance   | 0.25 0.25 0.25 | diffuse reflectance, or a spectrum texture       |
+// | rgb transmittance | 0.25 0.25 0.25 | diffuse transmittance, or a spectrum texture     |
 // | float scale       | 1              | multiplies both                                  |
 //
-// As in pbrt-v4, R + T above 1 is accepted (it adds energy); each of them must be in [0, 1].
+// As in pbrt-v4, R + T above 1 is accepted (it adds energy); each of them must be in [0, 1] (textured
+// values are clamped to it at each hit).
 #include <penumbra/bsdf.h>
 #include <penumbra/plugin.h>
 #include <penumbra/sampling.h>
@@ -68,9 +69,26 @@ class DiffuseTransmissionBsdf final : public Bsdf {
   float p_reflect_;
 };
 
+// Textured reflectance or transmittance: a DiffuseTransmissionBsdf made on the stack at each call.
+class TexturedDiffuseTransmissionBsdf final : public PerHitBsdf<TexturedDiffuseTransmissionBsdf> {
+  friend class PerHitBsdf<TexturedDiffuseTransmissionBsdf>;
+
+ public:
+  TexturedDiffuseTransmissionBsdf(TexturedRgb r, TexturedRgb t, float scale) : r_(r), t_(t), scale_(scale) {}
+  uint32_t flags() const override { return BsdfReflection | BsdfTransmission | BsdfDiffuse; }
+
+ private:
+  DiffuseTransmissionBsdf at(const ShadingContext& ctx) const {
+    auto value = [&](const TexturedRgb& tex) { return glm::clamp(scale_ * tex.evaluate(ctx.tex), Rgb(0.f), Rgb(1.f)); };
+    return DiffuseTransmissionBsdf(value(r_), value(t_));
+  }
+  TexturedRgb r_, t_;
+  float scale_;
+};
+
 const ParamSpec kParams[] = {
-    {"rgb", "reflectance", "0.25 0.25 0.25", "diffuse reflectance, each channel in [0, 1]"},
-    {"rgb", "transmittance", "0.25 0.25 0.25", "diffuse transmittance, each channel in [0, 1]"},
+    {"rgb texture", "reflectance", "0.25 0.25 0.25", "diffuse reflectance, each channel in [0, 1], or a spectrum texture"},
+    {"rgb texture", "transmittance", "0.25 0.25 0.25", "diffuse transmittance, each channel in [0, 1], or a spectrum texture"},
     {"float", "scale", "1", "scales reflectance and transmittance"},
     {"unsupported", "displacement", "", "displacement is not supported"},
     {"unsupported", "normalmap", "", "normal maps are not supported yet"},
@@ -80,7 +98,9 @@ Object* create(const CreateContext& ctx) {
   const ParamSet& p = ctx.params;
   float scale = p.get_float("scale");
   if (!(scale >= 0.f)) throw Error(p.loc_of("scale"), "scale must be >= 0");
-  Rgb r = scale * p.get_rgb("reflectance"), t = scale * p.get_rgb("transmittance");
+  TexturedRgb r_tex = ctx.rgb_input("reflectance"), t_tex = ctx.rgb_input("transmittance");
+  if (!r_tex.is_constant() || !t_tex.is_constant()) return new TexturedDiffuseTransmissionBsdf(r_tex, t_tex, scale);
+  Rgb r = scale * r_tex.constant(), t = scale * t_tex.constant();
   auto in_unit = [](Rgb c) { return c.r >= 0.f && c.g >= 0.f && c.b >= 0.f && c.r <= 1.f && c.g <= 1.f && c.b <= 1.f; };
   if (!in_unit(r)) throw Error(p.loc_of("reflectance"), "scale * reflectance must be in [0, 1]");
   if (!in_unit(t)) throw Error(p.loc_of("transmittance"), "scale * transmittance must be in [0, 1]");
