@@ -118,9 +118,9 @@ TEST(Cli, WrongValueCountIsLocated) {
 }
 
 TEST(Cli, UnknownPluginListsAvailable) {
-  auto r = render_text("plugin", scene_with("Integrator \"volpath\"\n", ""));
+  auto r = render_text("plugin", scene_with("Integrator \"whitted\"\n", ""));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:1: error: unknown integrator 'volpath'; available: bdpt, lighttracing, path, sppm"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:4:1: error: unknown integrator 'whitted'; available: bdpt, lighttracing, path, sppm, volpath"));
 }
 
 TEST(Cli, MissingPlyFileIsLocated) {
@@ -174,7 +174,7 @@ TEST(Cli, BadCommandLineOptionsNameTheOption) {
   EXPECT_THAT(r.err, HasSubstr("/no/such/scene.pbrt"));
   r = test::run_penumbra({"render", kSource + "/scenes/cornell-box/scene.pbrt", "--integrator", "nope", "-q"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("unknown integrator 'nope'; available: bdpt, lighttracing, path, sppm"));
+  EXPECT_THAT(r.err, HasSubstr("unknown integrator 'nope'; available: bdpt, lighttracing, path, sppm, volpath"));
 }
 
 // A diffuse sphere under a point light: nothing emits where the camera looks, so maxdepth 0 renders

@@ -58,7 +58,14 @@ Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMo
   v.light = si.area_light;
   v.beta = beta;
   v.mode = mode;
+  v.media = si.media;
   return v;
+}
+
+// The medium a segment leaving vertex v towards d travels in (MediumInterface::leaving; unknown for
+// cameras and lights).
+int medium_side(const Vertex& v, const Vec3& d) {
+  return v.kind == VertexKind::Surface ? v.media.leaving(v.ng, d, v.medium) : kMediumUnknown;
 }
 
 // pdf_area(&a, cur, b) and pdf_area(&b, cur, a) for a surface vertex `cur` that has a predecessor,
@@ -91,8 +98,14 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     Vertex& v = path[added + 1];
     Vertex* before = added > 0 ? &path[added - 1] : nullptr;
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
+    int medium = kMediumUnknown;
+    if (scene.has_media()) {  // absorption along the segment just traced
+      medium = segment_medium(medium_side(prev, ray.d), si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
+      beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
+    }
     if (si) {
       v = surface_vertex(*si, beta, mode);
+      v.medium = static_cast<int16_t>(medium);
     } else if (mode == TransportMode::Radiance && !scene.infinite_lights().empty()) {
       // Camera rays that escape may see environment lights: keep them as an endpoint at infinity.
       v = Vertex{};
@@ -450,6 +463,8 @@ Rgb connect_surfaces(const Context& ctx, const Vertex* light, int s, const Verte
   if (!(dist2 > 0.f)) return Rgb(0.f);
   Vec3 wn = d / std::sqrt(dist2);
   L *= std::abs(glm::dot(qs.ns, wn)) * std::abs(glm::dot(pt.ns, wn)) / dist2;
+  if (ctx.scene.has_media())
+    L *= ctx.scene.segment_transmittance(medium_side(qs, wn), medium_side(pt, -wn), std::sqrt(dist2));
   if (is_black(L) ||
       ctx.scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng)))
     return Rgb(0.f);
@@ -547,6 +562,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
     else  // a point on an area light seen directly (light tracing's s = 1)
       c.L = qs.beta * qs.light->L(qs.p, qs.ng, qs.tex.uv, cw->wi) * std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
+    if (scene.has_media())
+      c.L *= scene.segment_transmittance(medium_side(qs, cw->wi), kMediumUnknown, glm::length(cam.p - qs.p));
     if (is_black(c.L) || scene.occluded(shadow_ray(qs, cam.p, Vec3(0.f)))) {
       c.L = Rgb(0.f);
       return c;
@@ -604,6 +621,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     Vec3 w = direction_to(pt, lv);
     Vec3 wl = pt.shading.to_local(w);
     c.L = pt.beta * surface_f(pt, w, wl) * lv.beta * std::abs(glm::dot(ls->wi, pt.ns));
+    if (scene.has_media())
+      c.L *= scene.segment_transmittance(medium_side(pt, ls->wi), kMediumUnknown, glm::length(ls->p_light - pt.p));
     if (is_black(c.L) || scene.occluded(shadow_ray(pt, ls->p_light, ls->n_light))) {
       c.L = Rgb(0.f);
       return c;

@@ -68,6 +68,8 @@ struct Vertex {
   bool delta = false;     // scattered specularly towards the next vertex
   bool infinite = false;  // a direction rather than a point (escaped camera ray, environment, distant)
   TransportMode mode = TransportMode::Radiance;
+  MediumInterface media;  // surfaces: the media on their two sides (absorption between vertices)
+  int16_t medium = kMediumUnknown;  // surfaces: the medium the subpath arrived in, where known
   // Light endpoints traced by light_subpath(): next_event_ratio(path[0], path[1]), which every
   // connection with s >= 2 light vertices needs for its MIS weight (NaN: not known, computed when
   // needed). Fits in the padding after `mode`.

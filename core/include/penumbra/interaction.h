@@ -18,6 +18,37 @@ namespace penumbra {
 class Bsdf;
 class Light;
 
+/// A medium not known at this point: the medium is whatever the ray was in.
+constexpr int kMediumUnknown = -2;
+
+/// The media on the two sides of a surface (pbrt-v4's MediumInterface): indices into the scene's
+/// media, -1 for vacuum. A surface whose two sides differ bounds a medium (a transition); one with
+/// the same medium on both sides sits inside it; one with vacuum on both (the default) says nothing,
+/// and rays keep the medium they were in, as in pbrt-v4.
+struct MediumInterface {
+  int16_t inside = -1, outside = -1;
+  bool is_transition() const { return inside != outside; }
+  /// The medium on the side that `d` points into (outside is where the geometric normal `ng`
+  /// points), or kMediumUnknown when the surface says nothing.
+  int toward(const Vec3& ng, const Vec3& d) const {
+    if (!is_transition()) return inside >= 0 ? inside : kMediumUnknown;
+    return d.x * ng.x + d.y * ng.y + d.z * ng.z > 0.f ? outside : inside;
+  }
+  /// The medium of a ray leaving the surface towards `d`, for a path that arrived in `current`.
+  int leaving(const Vec3& ng, const Vec3& d, int current) const {
+    int m = toward(ng, d);
+    return m != kMediumUnknown ? m : current;
+  }
+};
+
+/// The medium a straight segment runs through, from what its two ends say: `from` is the medium
+/// the segment leaves its first end into (MediumInterface::leaving(), or kMediumUnknown for a
+/// camera or light point), `to_side` MediumInterface::toward() at the end it reaches, looking back.
+/// The leaving end decides, as it does for a ray in pbrt-v4; else the reached end; else vacuum (-1).
+constexpr int segment_medium(int from, int to_side) {
+  return from != kMediumUnknown ? from : to_side != kMediumUnknown ? to_side : -1;
+}
+
 struct Ray {
   Vec3 o;
   Vec3 d;
@@ -106,6 +137,7 @@ struct SurfaceInteraction {
   const Bsdf* bsdf = nullptr;         // material at the hit (never null for scene geometry)
   const Light* area_light = nullptr;  // emitter on this primitive, if any
   uint32_t shape_id = 0, prim_id = 0;
+  MediumInterface media;              // media on the two sides (vacuum on both unless the scene says)
 
   TextureEvalContext texture_context() const {
     return TextureEvalContext{p, ng, uv, dpdx, dpdy, dudx, dudy, dvdx, dvdy};

@@ -40,6 +40,19 @@ class Scene {
 
   virtual const Camera& camera() const = 0;
   virtual Bounds3 bounds() const = 0;
+
+  /// Participating media: pbrt-v4's homogeneous media that absorb without scattering, bounded by
+  /// surfaces whose SurfaceInteraction::media differ on their two sides. Whether the scene has any
+  /// (integrators may skip all medium bookkeeping when not).
+  virtual bool has_media() const { return false; }
+  /// Beer-Lambert transmittance exp(-sigma_a distance) of medium `medium` (-1, vacuum: 1). An
+  /// infinite distance through an absorbing medium gives 0.
+  virtual Rgb transmittance(int medium, float distance) const;
+  /// Transmittance of a segment between two ends (see segment_medium()).
+  Rgb segment_transmittance(int from_side, int to_side, float distance) const {
+    int m = segment_medium(from_side, to_side);
+    return m < 0 ? Rgb(1.f) : transmittance(m, distance);
+  }
 };
 
 }  // namespace penumbra

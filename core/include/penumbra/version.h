@@ -15,7 +15,9 @@
 // 6: Camera gained connectible() (orthographic cameras: light paths cannot connect to them).
 // 7: texture plugins (PluginKind::Texture, texture.h); ShadingContext carries a TextureEvalContext;
 //    SurfaceInteraction gained a pixel footprint; Camera::approximate_dp_dxy().
-#define PENUMBRA_SDK_VERSION 7
+// 8: absorbing media: SurfaceInteraction::media (MediumInterface), Scene::has_media(),
+//    Scene::transmittance().
+#define PENUMBRA_SDK_VERSION 8
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

@@ -50,6 +50,8 @@ void SceneParser::camera(const Token& d) {
   desc_.camera = make_entity(d, "camera type");
   glm::dmat4 world_from_camera = glm::inverse(state_.ctm);
   desc_.camera.to_world = Mat4(world_from_camera);
+  desc_.camera_medium = state_.medium_outside;  // pbrt-v4: the camera sits in the outside medium
+  desc_.camera_medium_loc = state_.medium_loc;
   named_coordinate_systems_["camera"] = world_from_camera;
 }
 
@@ -116,11 +118,51 @@ void SceneParser::shape(const Token& d) {
   require_world(d);
   ShapeEntity s;
   static_cast<SceneEntity&>(s) = make_entity(d, "shape type");
+  take_graphics_state(s);
+  desc_.shapes.push_back(std::move(s));
+}
+
+void SceneParser::take_graphics_state(ShapeEntity& s) const {
   s.material = state_.material;
   s.material_name = state_.material_name;
   s.material_loc = state_.material_loc;
   s.area_light = state_.area_light;
-  desc_.shapes.push_back(std::move(s));
+  s.medium_inside = state_.medium_inside;
+  s.medium_outside = state_.medium_outside;
+  s.medium_loc = state_.medium_loc;
+}
+
+// pbrt-v4: media are named globally, before or after WorldBegin, with their kind in "string type".
+// Which kinds Penumbra simulates is the scene builder's question (only media that are used matter).
+void SceneParser::make_named_medium(const Token& d) {
+  Token name = expect_string(d, "medium name");
+  if (auto it = desc_.named_media.find(name.text); it != desc_.named_media.end())
+    throw Error(name.loc, fmt::format("named medium '{}' redefined (first defined at {})", name.text,
+                                      desc_.media[it->second].loc.str()));
+  ParamSet given = parse_param_list(*tok_);
+  const Param* type = given.find("type");
+  if (!type) throw Error(d.loc, fmt::format("MakeNamedMedium '{}' needs a \"string type\" parameter", name.text));
+  if (type->type != "string" || type->strings.size() != 1)
+    throw Error(type->loc, "the 'type' of a named medium must be one string");
+  ParamSet params;
+  for (const auto& p : given.params())
+    if (p.name != "type") params.add(p);
+  MediumEntity m;
+  static_cast<SceneEntity&>(m) = entity_at(d, type->strings[0], std::move(params));
+  m.name = name.text;
+  desc_.media.push_back(std::move(m));
+  desc_.named_media[name.text] = static_cast<int>(desc_.media.size()) - 1;
+}
+
+// `MediumInterface "inside" "outside"`, or one name for both sides; "" is vacuum. The names are
+// resolved when the scene is built (a medium may be defined after the interface that names it).
+void SceneParser::medium_interface(const Token& d) {
+  Token inside = expect_string(d, "medium name (inside)");
+  std::string outside = inside.text;
+  if (tok_->peek().kind == TokenKind::String) outside = tok_->next().text;
+  state_.medium_inside = inside.text;
+  state_.medium_outside = outside;
+  state_.medium_loc = d.loc;
 }
 
 // pbrt-v4: textures are named globally (not scoped by attributes); float and spectrum textures

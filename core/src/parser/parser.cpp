@@ -17,8 +17,7 @@ namespace {
 // pbrt-v4 directives Penumbra knowingly leaves out: naming them gives a clear message instead of
 // "unknown directive".
 const std::set<std::string> kUnsupported = {
-    "ActiveTransform", "Attribute",      "MakeNamedMedium", "MediumInterface", "ObjectBegin",
-    "ObjectEnd",       "ObjectInstance", "TransformTimes",
+    "ActiveTransform", "Attribute", "ObjectBegin", "ObjectEnd", "ObjectInstance", "TransformTimes",
 };
 
 
@@ -56,7 +55,9 @@ const std::map<std::string, SceneParser::Handler>& SceneParser::handlers() {
       {"LightSource", &SceneParser::light_source},
       {"LookAt", &SceneParser::look_at},
       {"MakeNamedMaterial", &SceneParser::make_named_material},
+      {"MakeNamedMedium", &SceneParser::make_named_medium},
       {"Material", &SceneParser::material},
+      {"MediumInterface", &SceneParser::medium_interface},
       {"NamedMaterial", &SceneParser::named_material},
       {"Option", &SceneParser::option},
       {"PixelFilter", &SceneParser::pixel_filter},
@@ -167,10 +168,7 @@ void SceneParser::include(const Token& d) {
     ParamSet params;
     params.add(Param{"string", "filename", file.loc, {}, {file.text}, {}});
     static_cast<SceneEntity&>(s) = entity_at(d, "gltf", std::move(params));
-    s.material = state_.material;
-    s.material_name = state_.material_name;
-    s.material_loc = state_.material_loc;
-    s.area_light = state_.area_light;
+    take_graphics_state(s);
     desc_.shapes.push_back(std::move(s));
     return;
   }

@@ -28,6 +28,14 @@ struct ShapeEntity : SceneEntity {
   std::string material_name;    // NamedMaterial in effect (resolved by the builder)
   FileLoc material_loc;         // where that NamedMaterial directive is
   int area_light = -1;          // index into SceneDescription::area_lights, or -1
+  // MediumInterface in effect: named media inside and outside ("" = vacuum), and where it was set.
+  std::string medium_inside, medium_outside;
+  FileLoc medium_loc;
+};
+
+/// `MakeNamedMedium "name" "string type" "homogeneous" ...`: type is the medium's "string type".
+struct MediumEntity : SceneEntity {
+  std::string name;
 };
 
 /// `Texture "name" "float"|"spectrum" "class" ...`: type is the class (the plugin's name).
@@ -49,6 +57,10 @@ struct SceneDescription {
   std::vector<SceneEntity> lights;                // LightSource
   std::vector<SceneEntity> area_lights;           // AreaLightSource
   std::vector<ShapeEntity> shapes;
+  std::vector<MediumEntity> media;                // MakeNamedMedium, in file order
+  std::map<std::string, int> named_media;         // name -> index into media
+  std::string camera_medium;                      // outside medium of the MediumInterface at Camera
+  FileLoc camera_medium_loc;
   FileLoc world_begin;   // where WorldBegin is; no filename when the scene has none
 };
 

@@ -24,6 +24,8 @@ struct GraphicsState {
   std::string material_name;
   FileLoc material_loc;
   int area_light = -1;
+  std::string medium_inside, medium_outside;  // MediumInterface ("" = vacuum)
+  FileLoc medium_loc;
 };
 
 class SceneParser {
@@ -87,6 +89,9 @@ class SceneParser {
   void area_light_source(const Token& d);
   void light_source(const Token& d);
   void shape(const Token& d);
+  void take_graphics_state(ShapeEntity& s) const;  // material, area light, media
+  void make_named_medium(const Token& d);
+  void medium_interface(const Token& d);
   void texture(const Token& d);
   void reverse_orientation(const Token& d);
   void accelerator(const Token& d);

@@ -26,7 +26,7 @@ EmbreeScene::~EmbreeScene() {
 }
 
 void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
-                           std::vector<const Light*> lights, bool textured) {
+                           std::vector<const Light*> lights, bool textured, MediumInterface media) {
   mesh->finish();
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
@@ -46,11 +46,12 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
   unsigned id = rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);
   if (geometries_.size() <= id) geometries_.resize(id + 1);
-  geometries_[id] = Geometry{mesh.get(), nullptr, nullptr, bsdf, std::move(lights), textured};
+  geometries_[id] = Geometry{mesh.get(), nullptr, nullptr, bsdf, std::move(lights), textured, media};
   meshes_.push_back(std::move(mesh));
 }
 
-void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured) {
+void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured,
+                             MediumInterface media) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_SPHERE_POINT);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                         RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
@@ -64,7 +65,7 @@ void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, c
   if (geometries_.size() <= id) geometries_.resize(id + 1);
   std::vector<const Light*> lights;
   if (light) lights.push_back(light);
-  geometries_[id] = Geometry{nullptr, sphere.get(), nullptr, bsdf, std::move(lights), textured};
+  geometries_[id] = Geometry{nullptr, sphere.get(), nullptr, bsdf, std::move(lights), textured, media};
   spheres_.push_back(std::move(sphere));
 }
 
@@ -99,7 +100,7 @@ static void quadric_occluded(const RTCOccludedFunctionNArguments* args) {
 }
 
 void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light,
-                               bool textured) {
+                              bool textured, MediumInterface media) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(geom, 1);
   rtcSetGeometryUserData(geom, quadric.get());
@@ -120,6 +121,7 @@ void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf
   g.bsdf = bsdf;
   g.lights = std::move(lights);
   g.textured = textured;
+  g.media = media;
   geometries_[id] = std::move(g);
   quadrics_.push_back(std::move(quadric));
 }
@@ -186,6 +188,7 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   si.shape_id = rh.hit.geomID;
   si.prim_id = rh.hit.primID;
   si.bsdf = g.bsdf;
+  si.media = g.media;
   if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? rh.hit.primID : 0];
   Vec3 quadric_dpdu(0.f), quadric_dpdv(0.f);
   if (g.mesh) {
@@ -238,6 +241,13 @@ void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Geometry& 
   };
   solve(si.dpdx, &si.dudx, &si.dvdx);
   solve(si.dpdy, &si.dudy, &si.dvdy);
+}
+
+Rgb EmbreeScene::transmittance(int medium, float distance) const {
+  if (medium < 0) return Rgb(1.f);
+  const Rgb& sigma = media_sigma_a_[medium];
+  auto channel = [&](float s) { return s == 0.f ? 1.f : std::exp(-s * distance); };  // 0 * inf is no absorption
+  return Rgb(channel(sigma.r), channel(sigma.g), channel(sigma.b));
 }
 
 bool EmbreeScene::occluded(const Ray& ray) const {

@@ -27,13 +27,20 @@ class EmbreeScene final : public Scene {
 
   /// Adds a mesh; `lights` is empty or holds one area light per triangle. Hits on geometry whose
   /// material is `textured` get uv derivatives and a pixel footprint (SurfaceInteraction::dpdx ...).
+  /// `media`: the media on the geometry's two sides (indices into set_media()'s table).
   void add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf, std::vector<const Light*> lights,
-                bool textured = false);
-  void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured = false);
+                bool textured = false, MediumInterface media = {});
+  void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured = false,
+                  MediumInterface media = {});
   /// Multiplies the texture footprint: pbrt-v4's max(1/8, 1/sqrt(spp)), since many samples per pixel
   /// already average what a wider filter would. 1 until set.
   void set_texture_footprint_scale(float s) { footprint_scale_ = s; }
-  void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light, bool textured = false);
+  void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light, bool textured = false,
+                   MediumInterface media = {});
+  /// Absorption coefficients of the media that geometry names by index.
+  void set_media(std::vector<Rgb> sigma_a) { media_sigma_a_ = std::move(sigma_a); }
+  bool has_media() const override { return !media_sigma_a_.empty(); }
+  Rgb transmittance(int medium, float distance) const override;
   /// Meshes and spheres kept for area lights to reference before commit().
   const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
 
@@ -64,10 +71,12 @@ class EmbreeScene final : public Scene {
     const Bsdf* bsdf = nullptr;
     std::vector<const Light*> lights;    // per primitive, or empty
     bool textured = false;
+    MediumInterface media;
   };
   void add_texture_footprint(SurfaceInteraction& si, const Geometry& g, const Vec3& quadric_dpdu,
                              const Vec3& quadric_dpdv) const;
 
+  std::vector<Rgb> media_sigma_a_;
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   std::vector<std::unique_ptr<TriangleMesh>> meshes_;

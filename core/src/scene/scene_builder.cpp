@@ -3,6 +3,7 @@
 
 #include "parser/ply_reader.h"
 #include "scene/gltf_loader.h"
+#include "scene/media.h"
 #include "scene/orthographic_camera.h"
 #include "scene/perspective_camera.h"
 
@@ -321,6 +322,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     all_lights.push_back(out.lights.back().get());
     return out.lights.back().get();
   };
+  MediaTable media(desc);
   std::vector<std::unique_ptr<Triangle>> light_triangles;
   auto add_mesh = [&](const ShapeEntity& s, std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
                       bool is_textured) {
@@ -335,11 +337,14 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         lights.push_back(make_area_light(s, light_triangles.back().get()));
       }
     }
-    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured);
+    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s));
   };
   for (auto& s : desc.shapes) {
-    if (!material_of(s)) {  // "interface": no surface, rays pass (Penumbra has no media for it to bound)
+    if (!material_of(s)) {  // "interface": no surface, rays pass
       if (s.area_light >= 0) throw Error(s.loc, "an area light on a shape with material 'interface' is not supported");
+      if (media.interface_of(s).is_transition())
+        throw Error(s.loc, "a shape with material 'interface' that bounds a medium is not supported yet (give it a "
+                           "dielectric material with eta 1 to bound the medium)");
       continue;
     }
     if (s.type == "trianglemesh" || s.type == "plymesh") {
@@ -359,7 +364,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Sphere> sphere = load_sphere(s);
       const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get()) : nullptr;
-      out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s));
+      out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s), media.interface_of(s));
     } else if (s.type == "disk" || s.type == "cylinder") {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Quadric> quadric = load_quadric(s);
@@ -370,13 +375,15 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
                              "supported (its emission could not be sampled uniformly by area)");
         light = make_area_light(s, quadric.get());
       }
-      out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s));
+      out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s));
     } else {
       throw Error(s.loc, fmt::format("unsupported shape '{}'; available: cylinder, disk, gltf, plymesh, sphere, trianglemesh",
                                      s.type));
     }
   }
   out.scene->adopt_shapes(std::move(light_triangles));
+  if (!media.sigma_a().empty()) out.structures_built.push_back("absorbing_media");
+  out.scene->set_media(media.sigma_a());
 
   for (auto& l : desc.lights) {
     auto light = registry.create<Light>(PluginKind::Light, l.type, l.params,

@@ -36,9 +36,15 @@ class PathIntegrator final : public PixelIntegrator {
     float bsdf_pdf = 0.f;            // density of the direction that produced `ray`
     float eta_scale = 1.f;           // product of eta'^2 over the refractions so far
     LightSampleContext prev_ctx;     // the vertex that produced `ray`
+    int medium = kMediumUnknown;     // the medium `ray` travels in, where known (absorbing media)
+    const bool media = scene.has_media();
 
     for (int depth = 0;; ++depth) {
       std::optional<SurfaceInteraction> si = scene.intersect(ray);
+      if (media) {  // absorption along the segment just traced
+        medium = segment_medium(medium, si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
+        beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
+      }
       if (!si) {
         for (const Light* light : scene.infinite_lights()) {
           Rgb Le = light->Le(ray);
@@ -78,7 +84,7 @@ class PathIntegrator final : public PixelIntegrator {
       float u_light = sampler.get_1d();
       Vec2 u_light_point = sampler.get_2d();
       if (light_sampling_ && bsdf.flags() != 0 && !bsdf.is_specular_only())
-        L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point);
+        L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point, medium);
 
       // Continue the path by sampling the BSDF.
       float u_lobe = sampler.get_1d();
@@ -98,6 +104,7 @@ class PathIntegrator final : public PixelIntegrator {
       if (bs->flags & BsdfTransmission) eta_scale *= sqr(bs->eta);
       prev_ctx = LightSampleContext{si->p, si->ng};
       ray = si->spawn_ray(wi);
+      medium = si->media.leaving(si->ng, wi, medium);
 
       // Roulette on the throughput without the 1/eta'^2 of refractions (pbrt-v4's etaScale): radiance
       // compressed inside glass is not less important, and would otherwise be ended too often.
@@ -112,7 +119,7 @@ class PathIntegrator final : public PixelIntegrator {
 
  private:
   Rgb sample_direct(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
-                    const Scene& scene, float u_light, Vec2 u) const {
+                    const Scene& scene, float u_light, Vec2 u, int arrived_in) const {
     std::optional<SampledLight> sl = scene.sample_light(u_light);
     if (!sl) return Rgb(0.f);
     LightSampleContext lctx{si.p, si.ng};
@@ -124,6 +131,9 @@ class PathIntegrator final : public PixelIntegrator {
     // Same leak test as for BSDF sampling, against the geometric normal.
     if ((wi.z * wo.z > 0.f) != (glm::dot(ls->wi, si.ng) * glm::dot(si.wo, si.ng) > 0.f)) return Rgb(0.f);
     if (scene.occluded(si.spawn_ray_to(ls->p_light, ls->n_light))) return Rgb(0.f);
+    if (scene.has_media())
+      f *= scene.segment_transmittance(si.media.leaving(si.ng, ls->wi, arrived_in), kMediumUnknown,
+                                       glm::length(ls->p_light - si.p));
     float light_pdf = sl->pmf * ls->pdf;
     if (is_delta_light(sl->light->type())) return f * ls->L / light_pdf;
     float w = power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
@@ -156,6 +166,11 @@ Object* create(const CreateContext& ctx) {
   return new PathIntegrator(max_depth, rr_depth, strategy == "mis");
 }
 
+// pbrt-v4's "volpath" is its path tracer with media; this one simulates the media Penumbra has
+// (absorbing, core/src/scene/media.h), so scenes that name it render unchanged.
+const char* const kAliases[] = {"volpath", nullptr};
+
 }  // namespace
 
-PENUMBRA_PLUGIN(Integrator, "path", "unidirectional path tracer with next-event estimation and MIS", kParams, create)
+PENUMBRA_PLUGIN_WITH_ALIASES(Integrator, "path", "unidirectional path tracer with next-event estimation and MIS",
+                             kParams, create, kAliases)

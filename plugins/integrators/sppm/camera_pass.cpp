@@ -29,7 +29,7 @@ struct DirectSamples {
 // (power heuristic); the BSDF ray counts any emitter it finds, whose light-sampling density is
 // pmf(light) * pdf_li, exactly as in the path integrator.
 Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
-                 const Scene& scene, const DirectSamples& u, bool rays_find_lights) {
+                 const Scene& scene, const DirectSamples& u, bool rays_find_lights, int arrived_in) {
   Rgb L(0.f);
   LightSampleContext lctx{si.p, si.ng};
   if (std::optional<SampledLight> sl = scene.sample_light(u.u_light)) {
@@ -39,6 +39,9 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
       Rgb f = bsdf.f(wo, wi, sctx) * std::abs(wi.z);
       if (!is_black(f) && consistent_sides(si, wo, wi, ls->wi) &&
           !scene.occluded(spawn_ray_to(si.p, si.ng, ls->p_light, ls->n_light))) {
+        if (scene.has_media())
+          f *= scene.segment_transmittance(si.media.leaving(si.ng, ls->wi, arrived_in), kMediumUnknown,
+                                           glm::length(ls->p_light - si.p));
         float light_pdf = sl->pmf * ls->pdf;
         float w = is_delta_light(sl->light->type()) ? 1.f : power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
         L += f * ls->L * w / light_pdf;
@@ -57,7 +60,12 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
   if (!consistent_sides(si, wo, bs->wi, wi)) return L;
   Rgb weight = bs->f * std::abs(bs->wi.z) / bs->pdf;
   Ray ray = si.spawn_ray(wi);
-  if (std::optional<SurfaceInteraction> hit = scene.intersect(ray)) {
+  std::optional<SurfaceInteraction> hit = scene.intersect(ray);
+  if (scene.has_media())
+    weight *= scene.segment_transmittance(si.media.leaving(si.ng, wi, arrived_in),
+                                          hit ? hit->media.toward(hit->ng, -wi) : kMediumUnknown,
+                                          hit ? hit->t * glm::length(ray.d) : Infinity);
+  if (hit) {
     if (const Light* light = hit->area_light) {
       Rgb Le = light->L(hit->p, hit->ng, hit->uv, hit->wo);
       if (!is_black(Le)) {
@@ -111,8 +119,13 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
   // SPPM's single sample per pixel and iteration is drawn from the (non-negative) filter itself.
   Rgb beta(1.f);
   bool specular_bounce = false;
+  int medium = kMediumUnknown;  // the medium `ray` travels in, where known (absorbing media)
   for (int depth = 0;; ++depth) {
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
+    if (scene.has_media()) {
+      medium = segment_medium(medium, si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
+      beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
+    }
     // Emission counts here only where direct lighting could not have found it: on the camera ray
     // and after specular bounces.
     bool count_emission = depth == 0 || specular_bounce;
@@ -134,7 +147,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     if (flags == 0) break;
     Vec3 wo = si->shading.to_local(si->wo);
     ShadingContext sctx{si->texture_context(), TransportMode::Radiance};
-    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find_lights);
+    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find_lights, medium);
 
     // The continuation; a BSDF with diffuse and delta lobes needs it for the decision below.
     const bool diffuse = flags & BsdfDiffuse, has_delta = flags & BsdfSpecular;
@@ -167,6 +180,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     beta *= bs->f * std::abs(bs->wi.z) / bs->pdf;
     specular_bounce = bs->is_specular();
     ray = si->spawn_ray(wi);
+    medium = si->media.leaving(si->ng, wi, medium);
     // Roulette only for dim paths: a visible point's throughput multiplies every photon it gathers.
     float m = max_component(beta);
     if (m < 0.25f) {

@@ -40,9 +40,15 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& depos
 
   Ray ray = le->ray;
   ray.d = glm::normalize(ray.d);
+  int medium = kMediumUnknown;  // the medium `ray` travels in, where known (absorbing media)
   for (int depth = 0; depth < max_depth; ++depth) {
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
     if (!si) return;
+    if (scene.has_media()) {  // absorption along the segment: the photon's flux weight falls
+      medium = segment_medium(medium, si->media.toward(si->ng, -ray.d));
+      beta *= scene.transmittance(medium, si->t);
+      if (is_black(beta)) return;
+    }
     const Bsdf& bsdf = *si->bsdf;
     uint32_t flags = bsdf.flags();
     if (flags == 0) return;  // black: absorbs everything
@@ -72,6 +78,7 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& depos
     if (u_rr < q) return;
     beta = beta_new / (1.f - q);
     ray = si->spawn_ray(wi);
+    medium = si->media.leaving(si->ng, wi, medium);
   }
 }
 
