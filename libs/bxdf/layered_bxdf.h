@@ -30,6 +30,8 @@
 
 #include <penumbra/rng.h>
 
+#include <limits>
+
 namespace penumbra::bxdf {
 
 struct LayerParams {
@@ -44,7 +46,10 @@ template <class Bottom>
 class LayeredBxdf {
  public:
   LayeredBxdf(DielectricBxdf top, Bottom bottom, LayerParams params)
-      : top_(top), bottom_(bottom), p_(params), phase_(params.g) {}
+      : top_(top), bottom_(bottom), p_(params), phase_(params.g) {
+    // The walk tells the layers apart by height: a zero thickness would merge them.
+    p_.thickness = std::max(p_.thickness, std::numeric_limits<float>::min());
+  }
 
   const DielectricBxdf& top() const { return top_; }
   const Bottom& bottom() const { return bottom_; }
