@@ -257,7 +257,38 @@ float LayeredBxdf<Bottom>::pdf_walk(const Vec3& wo, const Vec3& wi, TransportMod
   }
   // The probability of flying from height zf along w_up to the top without scattering.
   auto reach_top = [&](float zf) { return has_medium() ? tr(h - zf, w_up) : 1.f; };
+  // Rough top: the density of leaving through wi at the top visit that follows an event, i.e. the
+  // integral over the upward direction v arriving at the top of full(v) reach(v) t(v): full is the
+  // density with which the walk's own sampling leads to v (through a mirror base if there is one),
+  // reach the probability of getting to the top unscattered, t(v) the top's density of refracting v
+  // into wi. Estimated by MIS from the direction the walk drew (`drawn`, with the forced-choice
+  // factor; drawing density `sampling`) and from a refraction of wi drawn by the top itself.
+  auto t_exit = [&](const Vec3& v) { return top_.pdf(-v, wi, mode); };
+  auto q_exit = [&](const Vec3& v) { return top_.pdf(wi, -v, adjoint(mode), Lobes::Transmission); };
+  auto rough_exit = [&](const Vec3& drawn, float factor, auto&& sampling, auto&& full, auto&& reach) {
+    float x = 0.f;
+    if (drawn.z > 0.f) x += power_heuristic(1, sampling(drawn), 1, q_exit(drawn)) * factor * reach(drawn) * t_exit(drawn);
+    std::optional<BsdfSample> s = top_.sample_f(wi, rng.next_float(), next2(rng), adjoint(mode), Lobes::Transmission);
+    if (usable(s)) {
+      Vec3 v = -s->wi;
+      float pe = sampling(v);
+      if (pe > 0.f) x += power_heuristic(1, s->pdf, 1, pe) * full(v) * reach(v) * t_exit(v) / s->pdf;
+    }
+    return x;
+  };
+  auto mirror = [](const Vec3& v) { return Vec3(v.x, v.y, -v.z); };
+  auto tr_h = [&](const Vec3& v) { return has_medium() ? tr(h, v) : 1.f; };
+  auto via_mirror = [&](const Vec3& v) { return tr_h(v) * tr_h(v); };  // down to the mirror and up again
+  // A top event (the entrance, or an internal reflection) that sent the walk down towards a mirror
+  // base from direction `from`, restricted to `lobe`: the next top visit is two events later.
+  auto rough_exit_after_top = [&](const Vec3& from, Lobes lobe, const std::optional<BsdfSample>& drawn, float factor) {
+    return rough_exit(
+        usable(drawn) ? mirror(drawn->wi) : Vec3(0.f), factor,
+        [&](const Vec3& v) { return top_.pdf(from, mirror(v), mode, lobe); },
+        [&](const Vec3& v) { return top_.pdf(from, mirror(v), mode, Lobes::All); }, via_mirror);
+  };
   float p = 0.f;
+  if (!smooth_top && bottom_delta && 1 < p_.max_depth) p += rough_exit_after_top(wo, Lobes::Transmission, wos, choice);
   Vec3 w = wos->wi;
   float z = h;
   for (int depth = 0; depth < p_.max_depth; ++depth) {
@@ -267,12 +298,29 @@ float LayeredBxdf<Bottom>::pdf_walk(const Vec3& wo, const Vec3& wi, TransportMod
       float zp = w.z > 0.f ? z + dz : z - dz;
       if (zp == z) break;
       if (0.f < zp && zp < h) {
+        Vec3 wn = phase_.sample(w, next2(rng));
         if (smooth_top) {
-          if (depth + 1 < p_.max_depth) p += weight * phase_.pdf(w, w_up) * reach_top(zp) * t_up * jacobian;
-          if (bottom_delta && depth + 2 < p_.max_depth)  // down to the mirror, then up and out
-            p += weight * phase_.pdf(w, w_down) * tr(zp, w_down) * reach_top(0.f) * t_up * jacobian;
+          // Straight up and out; with a mirror base also down to it first, and both after any number
+          // of round trips (internal reflection at the top, the mirror), each taking two more events.
+          float up = phase_.pdf(w, w_up) * reach_top(zp);
+          float down = bottom_delta ? phase_.pdf(w, w_down) * tr(zp, w_down) * reach_top(0.f) : 0.f;
+          float round_trip = bottom_delta ? (1.f - t_up) * tr(h, w_down) * reach_top(0.f) : 0.f;
+          for (int d = depth + 1; d < p_.max_depth && (up > 0.f || down > 0.f); d += 2) {
+            p += weight * (up + (d + 1 < p_.max_depth ? down : 0.f)) * t_up * jacobian;
+            up *= round_trip;
+            down *= round_trip;
+          }
+        } else {
+          auto phase_up = [&](const Vec3& v) { return phase_.pdf(w, v); };
+          if (depth + 1 < p_.max_depth)
+            p += weight * rough_exit(wn, 1.f, phase_up, phase_up, [&](const Vec3& v) { return tr(h - zp, v); });
+          if (bottom_delta && depth + 2 < p_.max_depth) {
+            auto phase_down = [&](const Vec3& v) { return phase_.pdf(w, mirror(v)); };
+            p += weight * rough_exit(wn.z < 0.f ? mirror(wn) : Vec3(0.f), 1.f, phase_down, phase_down,
+                                     [&](const Vec3& v) { return tr(zp, v) * tr(h, v); });
+          }
         }
-        w = phase_.sample(w, next2(rng));
+        w = wn;
         z = zp;
         continue;
       }
@@ -281,16 +329,22 @@ float LayeredBxdf<Bottom>::pdf_walk(const Vec3& wo, const Vec3& wi, TransportMod
       z = (z == h) ? 0.f : h;
     }
     if (z == h) {
-      if (!smooth_top) p += weight * top_.pdf(-w, wi, mode);  // leaving here through wi
-      std::optional<BsdfSample> bs =
-          top_.sample_f(-w, rng.next_float(), next2(rng), mode, Lobes::Reflection, &choice);
+      Vec3 from = -w;
+      std::optional<BsdfSample> bs = top_.sample_f(from, rng.next_float(), next2(rng), mode, Lobes::Reflection, &choice);
+      if (!smooth_top && bottom_delta && depth + 2 < p_.max_depth)
+        p += weight * rough_exit_after_top(from, Lobes::Reflection, bs, choice);
       if (!usable(bs)) break;
       weight *= choice;
       w = bs->wi;
     } else {
+      Vec3 from = -w;
       if (smooth_top && !bottom_delta && depth + 1 < p_.max_depth)
-        p += weight * bottom_.pdf(-w, w_up, mode) * reach_top(0.f) * t_up * jacobian;
-      std::optional<BsdfSample> bs = bottom_.sample_f(-w, rng.next_float(), next2(rng), mode);
+        p += weight * bottom_.pdf(from, w_up, mode) * reach_top(0.f) * t_up * jacobian;
+      std::optional<BsdfSample> bs = bottom_.sample_f(from, rng.next_float(), next2(rng), mode);
+      if (!smooth_top && !bottom_delta && depth + 1 < p_.max_depth) {
+        auto base = [&](const Vec3& v) { return bottom_.pdf(from, v, mode); };
+        p += weight * rough_exit(usable(bs) ? bs->wi : Vec3(0.f), 1.f, base, base, tr_h);
+      }
       if (!usable(bs)) break;
       w = bs->wi;
     }
