@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -268,6 +269,141 @@ TEST(LayeredBxdf, SamplingMatchesMeanPdfSmoothCoatMediumOverMirror) {
   CoatedConductorBxdf b(coat(0.f), ConductorBxdf(TrowbridgeReitz(0.f, 0.f), kCuEta / 1.5f, kCuK / 1.5f),
                         layer(0.5f, Rgb(0.7f), -0.3f, 10));
   expect_sampling_matches_pdf(b, spherical_direction(0.7f, 4.f), "smooth/medium/mirror", 54);
+}
+
+// ---- furnaces --------------------------------------------------------------------------------------
+
+// Directional albedo three ways: sample_f()'s weights, the mean of f() cos over uniform directions
+// (plus the delta reflection's Fresnel weight, which f() leaves out), and the simulation's weights.
+struct Albedos {
+  Mean sampled, integrated, simulated;
+};
+
+template <class Bottom>
+Albedos albedos(const LayeredBxdf<Bottom>& b, const Vec3& wo, uint64_t seed, int n = 400'000) {
+  Albedos a;
+  Pcg32 rng(seed, 5);
+  float delta_reflection = b.top().specular() ? fresnel_dielectric(wo.z, b.top().eta()) : 0.f;
+  for (int i = 0; i < n; ++i) {
+    std::optional<BsdfSample> s = b.sample_walk(wo, rng.next_float(), next2(rng), kRadiance, rng);
+    a.sampled.add(s ? luminance(s->f) * std::abs(s->wi.z) / s->pdf : 0.0);
+    Vec3 w = sample_uniform_sphere(next2(rng));
+    w.z = std::abs(w.z);
+    a.integrated.add(delta_reflection + luminance(b.f(wo, w, kRadiance, rng)) * w.z * 2.0 * 3.14159265358979323846);
+    std::optional<std::pair<Vec3, Rgb>> out = simulate(b, wo, rng);
+    a.simulated.add(out ? luminance(out->second) : 0.0);
+  }
+  return a;
+}
+
+TEST(LayeredBxdf, WhiteFurnaceRoughCoatOverWhiteDiffuse) {
+  // No absorption anywhere but the rough coat's single scattering: the albedo stays below 1 and the
+  // three estimates agree. (The simulation leaves the delta reflection out; a rough coat has none.)
+  CoatedDiffuseBxdf b(coat(0.3f), DiffuseBxdf(Rgb(1.f)), layer(0.f));
+  for (float c : {0.9f, 0.4f}) {
+    Vec3 wo = spherical_direction(c, 0.7f);
+    Albedos a = albedos(b, wo, 60 + static_cast<uint64_t>(10 * c));
+    EXPECT_LT(a.sampled.mean(), 1.0 + 4.0 * a.sampled.error());
+    expect_agree(a.sampled, a.simulated, "rough white furnace, sampled vs simulated, cos " + std::to_string(c));
+    expect_agree(a.integrated, a.simulated, "rough white furnace, f vs simulated, cos " + std::to_string(c));
+  }
+}
+
+TEST(LayeredBxdf, WhiteFurnaceSmoothCoatOverWhiteDiffuseIsOne) {
+  // Every walk carries weight exactly 1 (the coat's 1/eta^2 going in is undone coming out), so the
+  // albedo is the fraction of walks that leave within maxdepth: 1 to 1e-4 at maxdepth 100.
+  CoatedDiffuseBxdf b(coat(0.f), DiffuseBxdf(Rgb(1.f)), layer(0.f));
+  for (float c : {1.f, 0.5f, 0.1f}) {
+    Vec3 wo = spherical_direction(c, 0.2f);
+    Albedos a = albedos(b, wo, 70, 200'000);
+    EXPECT_NEAR(a.sampled.mean(), 1.0, 1e-4) << c;
+    EXPECT_GT(std::abs(0.98 * a.sampled.mean() - 1.0), 1e-4);  // a 2 % bias would fail
+    EXPECT_NEAR(a.integrated.mean(), 1.0, 4.0 * a.integrated.error()) << c;
+    EXPECT_LT(4.0 * a.integrated.error(), 0.015) << "too noisy to see a 2 % bias";
+    std::printf("  [smooth white furnace cos %.1f] sampled %.6f, f %.4f +- %.4f\n", c, a.sampled.mean(),
+                a.integrated.mean(), a.integrated.error());
+  }
+}
+
+TEST(LayeredBxdf, PerfectConductorUnderCoatLosesOnlyTheCoatsSingleScattering) {
+  const Rgb white_k = k_from_reflectance(Rgb(1.f));  // eta 1: F = 0.9999 at every angle
+  // Smooth coat, mirror base: energy is conserved (to the base's 1e-4 per bounce).
+  CoatedConductorBxdf smooth(coat(0.f), ConductorBxdf(TrowbridgeReitz(0.f, 0.f), Rgb(1.f), white_k), layer(0.f));
+  // Rough coat: what is lost is the coat's single-scattering GGX loss, paid going in and at every
+  // visit of the top from inside (light trapped by total internal reflection visits it often): the
+  // albedo stays below the coat's own energy albedo from wo, and matches the simulation.
+  CoatedConductorBxdf rough(coat(0.4f), ConductorBxdf(TrowbridgeReitz(0.f, 0.f), Rgb(1.f), white_k), layer(0.f));
+  for (float c : {0.9f, 0.4f}) {
+    Vec3 wo = spherical_direction(c, 1.3f);
+    Mean smooth_albedo, coat_albedo;
+    Pcg32 rng(80, 6);
+    for (int i = 0; i < 200'000; ++i) {
+      std::optional<BsdfSample> s = smooth.sample_walk(wo, rng.next_float(), next2(rng), kRadiance, rng);
+      smooth_albedo.add(s ? luminance(s->f) * std::abs(s->wi.z) / s->pdf : 0.0);
+      // The coat's energy albedo: importance transport, whose refraction weights carry no 1/eta^2.
+      std::optional<BsdfSample> t = rough.top().sample_f(wo, rng.next_float(), next2(rng), TransportMode::Importance);
+      coat_albedo.add(t ? luminance(t->f) * std::abs(t->wi.z) / t->pdf : 0.0);
+    }
+    EXPECT_NEAR(smooth_albedo.mean(), 1.0, 2e-3) << c;
+    EXPECT_GT(std::abs(0.98 * smooth_albedo.mean() - 1.0), 2e-3);
+    Albedos a = albedos(rough, wo, 81, 1'500'000);
+    EXPECT_LT(a.sampled.mean(), coat_albedo.mean() + 4.0 * std::hypot(a.sampled.error(), coat_albedo.error())) << c;
+    expect_agree(a.sampled, a.simulated, "rough coat over mirror, sampled vs simulated, cos " + std::to_string(c));
+    expect_agree(a.integrated, a.simulated, "rough coat over mirror, f vs simulated, cos " + std::to_string(c));
+    std::printf("  [mirror under coat, cos %.1f] smooth %.5f; rough %.4f, coat alone %.4f\n", c, smooth_albedo.mean(),
+                a.sampled.mean(), coat_albedo.mean());
+  }
+}
+
+// ---- the closed form of a Lambertian under a smooth dielectric ----------------------------------------
+
+// Unpolarised Fresnel reflectance of a dielectric, written out in double (not the SDK's).
+double fresnel(double cos_i, double eta) {
+  double sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+  if (sin2_t >= 1.0) return 1.0;
+  double cos_t = std::sqrt(1.0 - sin2_t);
+  double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t), rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+TEST(LayeredBxdf, SmoothCoatOverLambertianMatchesClosedForm) {
+  // Light entering at normal incidence passes with 1 - F0, is spread by the base into a cosine
+  // distribution, and leaves through the coat with probability 1 - r_i, where r_i is the coat's
+  // hemispherical (cosine-weighted) reflectance from inside, total internal reflection included; the
+  // rest returns to the base (albedo rho) and tries again:
+  //   albedo(normal) = F0 + (1 - F0) rho (1 - r_i) / (1 - rho r_i).
+  // Etendue links r_i to the outside hemispherical reflectance r_e: 1 - r_i = (1 - r_e) / eta^2. The
+  // BRDF at normal incidence and exit has the same series, with the base's radiance rho / pi leaving
+  // through (1 - F0) and compressed by 1/eta^2 into the outside solid angle:
+  //   f(normal, normal) = (1 - F0)^2 rho / (pi eta^2 (1 - rho r_i)).
+  const double eta = 1.5, rho = 0.6;
+  double r_e = 0.0;
+  constexpr int kSteps = 200'000;
+  for (int i = 0; i < kSteps; ++i) {
+    double mu = (i + 0.5) / kSteps;
+    r_e += fresnel(mu, eta) * 2.0 * mu / kSteps;
+  }
+  double r_i = 1.0 - (1.0 - r_e) / (eta * eta), f0 = fresnel(1.0, eta);
+  double albedo = f0 + (1.0 - f0) * rho * (1.0 - r_i) / (1.0 - rho * r_i);
+  double f_nn = sqr(1.0 - f0) * rho / (3.14159265358979323846 * eta * eta * (1.0 - rho * r_i));
+  std::printf("  [closed form] r_e %.5f, r_i %.5f, albedo %.5f, f(n, n) %.5f\n", r_e, r_i, albedo, f_nn);
+
+  CoatedDiffuseBxdf b(coat(0.f), DiffuseBxdf(Rgb(static_cast<float>(rho))), layer(0.f, Rgb(0.f), 0.f, 200));
+  const Vec3 n(0.f, 0.f, 1.f);
+  Mean a, f;
+  Pcg32 rng(90, 7);
+  for (int i = 0; i < 400'000; ++i) {
+    std::optional<BsdfSample> s = b.sample_walk(n, rng.next_float(), next2(rng), kRadiance, rng);
+    a.add(s ? s->f.r * std::abs(s->wi.z) / s->pdf : 0.0);
+    f.add(b.f(n, n, kRadiance, rng).r);
+  }
+  for (auto [m, expected, what] : {std::tuple{&a, albedo, "albedo"}, std::tuple{&f, f_nn, "f(n, n)"}}) {
+    double tol = std::max(4.0 * m->error(), 2e-4 * expected);
+    EXPECT_NEAR(m->mean(), expected, tol) << what;
+    EXPECT_GT(std::abs(1.02 * m->mean() - expected), tol) << what << ": a 2 % bias would pass";
+    std::printf("  [closed form %s] %.5f +- %.5f vs %.5f (ratio %.5f)\n", what, m->mean(), m->error(), expected,
+                m->mean() / expected);
+  }
 }
 
 }  // namespace
