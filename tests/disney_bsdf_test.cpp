@@ -1,4 +1,4 @@
-// The "disney" and "coateddiffuse" materials: sampling against pdf by chi-square over a grid of
+// The "disney" material: sampling against pdf by chi-square over a grid of
 // parameters that switches every lobe on (with a deliberately broken variant that must fail),
 // white-furnace albedos, reciprocity of the reflection lobes, and finite values at the edges
 // (roughness 0, eta 1, grazing and below-the-surface directions).
@@ -299,15 +299,6 @@ TEST(DisneyBsdf, DiffuseRetroReflectionMatchesTheModelsAlbedo) {
   EXPECT_GT(rough_max, 1.5);  // the excess is the model's, not a sampling artefact
 }
 
-TEST(DisneyBsdf, CoatedDiffuseStaysNearOne) {
-  // The approximation does not dim the base by what the coat reflects: white reflectance peaks at
-  // 1.025 (cos 0.3, smooth coat).
-  for (const char* r : {"0", "0.3"}) {
-    auto coated = make_bsdf("coateddiffuse", std::string(R"("rgb reflectance" [1 1 1] "float roughness" [)") + r + "]");
-    max_albedo(*coated, std::string("coateddiffuse roughness ") + r, 1.03, TransportMode::Radiance);
-  }
-}
-
 // ---- Reciprocity ---------------------------------------------------------------------------------
 
 TEST(DisneyBsdf, ReflectionIsReciprocal) {
@@ -419,7 +410,7 @@ TEST(DisneyBsdf, SampledValuesAgreeWithEvaluation) {
   }
 }
 
-// ---- Lobe summary, parameters, coateddiffuse ------------------------------------------------------
+// ---- Lobe summary, parameters ---------------------------------------------------------------------
 
 TEST(DisneyBsdf, LobeReportsTheDominantLobe) {
   Vec3 wo = spherical_direction(0.6f, 0.5f);
@@ -451,25 +442,8 @@ TEST(DisneyBsdf, RejectsBadAndUnsupportedParameters) {
   EXPECT_THROW(make_bsdf("disney", R"("rgb color" [1.2 0 0])"), Error);
   EXPECT_THROW(make_bsdf("disney", R"("float difftrans" [2.5])"), Error);
   EXPECT_THROW(make_bsdf("disney", R"("rgb scatterdistance" [1 1 1])"), Error);
-  EXPECT_THROW(make_bsdf("coateddiffuse", R"("float g" [0.3])"), Error);
+  EXPECT_THROW(make_bsdf("coateddiffuse", R"("float g" [1.5])"), Error);  // layered: g in (-1, 1)
   EXPECT_NO_THROW(make_bsdf("disney", R"("float difftrans" [2] "bool thin" [true])"));
-}
-
-TEST(CoatedDiffuse, WarnsAndSamplesItsOwnPdf) {
-  testing::internal::CaptureStderr();
-  auto smooth = make_bsdf("coateddiffuse", R"("rgb reflectance" [0.6 0.4 0.2])");
-  std::string err = testing::internal::GetCapturedStderr();
-  EXPECT_NE(err.find("coateddiffuse is approximated by Disney's diffuse + clearcoat"), std::string::npos) << err;
-  auto rough = make_bsdf("coateddiffuse", R"("float uroughness" [0.2] "float vroughness" [0.4] "float eta" [1.33])");
-
-  const double alpha = sidak_alpha(0.01, 3);
-  Vec3 wo = spherical_direction(0.7f, 1.f);
-  // Smooth coat: GTR1 alpha 0.001, too narrow for a sphere chart.
-  ChiSquareResult a = narrow_lobe_chi_square(*smooth, wo, 0.012f, 31);
-  ChiSquareResult b = bsdf_chi_square(*rough, wo, kChiSamples, 32);
-  ChiSquareResult c = bsdf_chi_square(*rough, spherical_direction(0.05f, 2.f), kChiSamples, 33);
-  for (const ChiSquareResult* r : {&a, &b, &c}) EXPECT_TRUE(r->passes(alpha)) << r->summary();
-  std::printf("  [coateddiffuse] p = %.3f %.3f %.3f\n", a.p_value, b.p_value, c.p_value);
 }
 
 // ---- Smooth lobes are deltas (TrowbridgeReitz::kSmoothAlpha, shared with conductor and dielectric) --

@@ -69,14 +69,14 @@ TEST(SceneBuilder, BuildsNoLightDistributionWithoutLights) {
 
 TEST(SceneBuilder, UnknownMaterialIsLocatedAndListsAvailable) {
   SceneDescription d = parse_scene_string(
-      "Camera \"perspective\"\nWorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"coatedconductor\"\nNamedMaterial \"m\"\nShape \"sphere\"\n",
+      "Camera \"perspective\"\nWorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"measuredbrdf\"\nNamedMaterial \"m\"\nShape \"sphere\"\n",
       "s.pbrt");
   Registry registry = builtin_registry();
   try {
     build_scene(d, registry);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_THAT(e.formatted(), ::testing::HasSubstr("s.pbrt:3:1: error: unknown bsdf 'coatedconductor'; available: "));
+    EXPECT_THAT(e.formatted(), ::testing::HasSubstr("s.pbrt:3:1: error: unknown bsdf 'measuredbrdf'; available: "));
     EXPECT_THAT(e.formatted(), ::testing::HasSubstr("conductor"));
   }
 }

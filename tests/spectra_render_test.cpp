@@ -52,10 +52,10 @@ TEST(SpectraRender, GoldSphereMatchesPbrtV4Means) {
 }
 
 // The real scene that needed named spectra: coffee (Bitterli, CC-BY) uses "metal-Ag-eta"/"metal-Ag-k".
-// It loads unchanged and renders without NaN/Inf with each integrator at low resolution. (Its image
-// mean is 1.5-1.7x pbrt-v4's because coateddiffuse is still approximated: with coateddiffuse
-// replaced by diffuse in both renderers, 160x200 at 64 spp, Penumbra / pbrt-v4 is R 1.005,
-// G 1.000, B 1.001.)
+// It loads unchanged and renders without NaN/Inf with each integrator at low resolution. (At 160x200,
+// 64 spp, Penumbra / pbrt-v4 is R 1.091, G 0.993, B 1.016 with the layered coateddiffuse; the red is
+// the saturated orange base, see docs/materials.md. With coateddiffuse replaced by diffuse in both
+// renderers it was R 1.005, G 1.000, B 1.001.)
 TEST(SpectraRender, CoffeeSceneLoadsAndRenders) {
   for (const char* integrator : {"path", "bdpt", "sppm"}) {
     RenderSettings s;

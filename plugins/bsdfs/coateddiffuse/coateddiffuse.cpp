@@ -1,84 +1,90 @@
-// Material "coateddiffuse" (pbrt-v4): a diffuse base under a dielectric coat. pbrt-v4 simulates the
-// layers stochastically; Penumbra approximates them with the Disney BSDF's pieces, and says so when
-// a scene uses it: Burley's diffuse with the base reflectance (its (1 - F/2) factors darken grazing
-// angles as a coat does) plus the GTR1 clearcoat at full strength, with R0 from the coat's eta and
-// its gloss from the coat's roughness. The Disney specular lobe is off (eta 1), so the coat is the
-// only specular reflection. Not energy-exact: the diffuse is not dimmed by what the coat reflects.
+// Material "coateddiffuse" (pbrt-v4): a Lambertian base under a dielectric coat, with an optional
+// scattering medium between them, evaluated by the stochastic layered BxDF of libs/bxdf
+// (layered_bxdf.h; docs/materials.md): f() and pdf() are Monte Carlo estimates, sample_f() a random
+// walk through the layers. Two-sided.
 //
-// | parameter            | default     | meaning                                                   |
-// |----------------------|-------------|-----------------------------------------------------------|
-// | rgb reflectance      | 0.5 0.5 0.5 | diffuse base albedo, each channel in [0, 1]               |
-// | float roughness      | 0           | coat roughness (both directions)                          |
-// | float uroughness     | roughness   | coat roughness along s (averaged with v: coat is isotropic) |
-// | float vroughness     | roughness   | coat roughness along t                                    |
-// | bool remaproughness  | true        | alpha = sqrt(roughness) as in pbrt-v4, else alpha = roughness |
-// | float thickness      | 0.01        | accepted and ignored (no absorption in the layer)         |
-// | float eta            | 1.5         | coat IOR, sets its normal-incidence reflectance           |
-//
-// Coat alpha maps to GTR1's: alpha 0 -> 0.001 (clearcoatgloss 1), alpha >= 0.1 -> 0.1 (gloss 0).
-// reflectance may be a spectrum texture and the roughnesses float textures (evaluated per hit,
-// reflectance clamped to [0, 1]).
-#include "../disney/disney_bsdf.h"
-#include "../disney/textured_disney.h"
-#include <penumbra/microfacet.h>
+// | parameter            | default     | meaning                                                      |
+// |----------------------|-------------|--------------------------------------------------------------|
+// | rgb reflectance      | 0.5 0.5 0.5 | base albedo, each channel in [0, 1] (or a spectrum texture)  |
+// | float roughness      | 0           | coat roughness (0: a smooth coat); a float texture or value  |
+// | float uroughness     | roughness   | coat roughness along the shading frame's s axis              |
+// | float vroughness     | roughness   | coat roughness along the shading frame's t axis              |
+// | bool remaproughness  | true        | alpha = sqrt(roughness), else alpha = roughness              |
+// | float thickness      | 0.01        | slab thickness in units of the medium's mean free path       |
+// | float eta            | 1.5         | coat IOR (a spectrum gives its luminance-weighted mean)      |
+// | rgb albedo           | 0 0 0       | single-scattering albedo of the medium (0: pure absorber)    |
+// | float g              | 0           | Henyey-Greenstein asymmetry of the medium                    |
+// | integer maxdepth     | 10          | most events of a walk                                        |
+// | integer nsamples     | 1           | walks averaged per f() and pdf() estimate                    |
+#include <bxdf_bsdf.h>
+#include <layer_inputs.h>
+#include <layered_bxdf.h>
 
+#include <penumbra/bsdf.h>
 #include <penumbra/plugin.h>
 
 namespace {
 
 using namespace penumbra;
+using namespace penumbra::bxdf;
+using CoatedDiffuseBsdf = BxdfBsdf<CoatedDiffuseBxdf>;
+
+// Textured parameters: each call evaluates them at the hit and forwards to the layered BxDF made on
+// the stack. Flags are the union over the parameters' range (smooth or rough coat).
+class TexturedCoatedDiffuseBsdf final : public PerHitBsdf<TexturedCoatedDiffuseBsdf> {
+  friend class PerHitBsdf<TexturedCoatedDiffuseBsdf>;
+
+ public:
+  TexturedCoatedDiffuseBsdf(TexturedRgb reflectance, MicrofacetRoughness rough, float eta, LayerInputs layer)
+      : reflectance_(reflectance), rough_(rough), eta_(eta), layer_(layer) {}
+  uint32_t flags() const override { return BsdfReflection | BsdfSpecular | BsdfDiffuse; }
+
+ private:
+  CoatedDiffuseBsdf at(const ShadingContext& ctx) const {
+    return CoatedDiffuseBsdf(CoatedDiffuseBxdf(DielectricBxdf(eta_, rough_.at(ctx.tex)),
+                                               DiffuseBxdf(glm::clamp(reflectance_.evaluate(ctx.tex), Rgb(0.f), Rgb(1.f))),
+                                               layer_.at(ctx.tex)));
+  }
+  TexturedRgb reflectance_;
+  MicrofacetRoughness rough_;
+  float eta_;
+  LayerInputs layer_;
+};
 
 const ParamSpec kParams[] = {
-    {"rgb texture", "reflectance", "0.5 0.5 0.5", "diffuse base albedo, each channel in [0, 1]"},
-    {"float texture", "roughness", "0", "coat roughness"},
+    {"rgb texture", "reflectance", "0.5 0.5 0.5", "base albedo, each channel in [0, 1]"},
+    {"float texture", "roughness", "0", "coat roughness (0: smooth)"},
     {"float texture", "uroughness", "", "coat roughness along s (default: roughness)"},
     {"float texture", "vroughness", "", "coat roughness along t (default: roughness)"},
     {"bool", "remaproughness", "true", "alpha = sqrt(roughness) when true, alpha = roughness otherwise"},
-    {"float", "thickness", "0.01", "coat thickness: accepted and ignored (no absorption modelled)"},
+    {"float texture", "thickness", "0.01", "thickness of the slab between coat and base (unit extinction)"},
     {"float|spectrum", "eta", "1.5", "coat index of refraction; a spectrum gives its luminance-weighted mean"},
-    {"unsupported", "albedo", "", "a scattering coat layer is not supported"},
-    {"unsupported", "g", "", "a scattering coat layer is not supported"},
-    {"unsupported", "maxdepth", "", "the layers are approximated, not random-walked"},
-    {"unsupported", "nsamples", "", "the layers are approximated, not random-walked"},
+    {"rgb texture", "albedo", "0 0 0", "single-scattering albedo of the medium in the slab (0: absorbing)"},
+    {"float texture", "g", "0", "Henyey-Greenstein asymmetry of the medium"},
+    {"integer", "maxdepth", "10", "most scattering events of a random walk through the layers"},
+    {"integer", "nsamples", "1", "random walks averaged per f() and pdf() estimate"},
     {"unsupported", "displacement", "", "displacement is not supported"},
     {"unsupported", "normalmap", "", "normal maps are not supported yet"},
 };
 
-// The Disney parameters of the approximation for a base reflectance and coat alphas.
-disney::DisneyParams coated_params(Rgb reflectance, Vec2 uv_alpha, float eta) {
-  float alpha = std::sqrt(uv_alpha.x * uv_alpha.y);  // GTR1 is isotropic: keep the lobe's area
-  disney::DisneyParams p;
-  p.color = reflectance;
-  p.metallic = 0.f;
-  p.eta = 1.f;          // no Disney specular lobe: the clearcoat is the coat
-  p.roughness = 0.f;    // no retro-reflection: pbrt-v4's base is Lambertian
-  p.clearcoat = 4.f;    // weight 0.25 * 4 = 1: a real coat reflects its full Fresnel
-  p.clearcoat_gloss = std::clamp((0.1f - alpha) / (0.1f - 0.001f), 0.f, 1.f);
-  p.clearcoat_r0 = disney::schlick_r0_from_eta(eta);
-  return p;
-}
-
 Object* create(const CreateContext& ctx) {
   const ParamSet& ps = ctx.params;
   TexturedRgb reflectance = ctx.rgb_input("reflectance");
-  Rgb r = reflectance.is_constant() ? reflectance.constant() : Rgb(0.5f);
-  if (!(glm::all(glm::greaterThanEqual(r, Rgb(0.f))) && glm::all(glm::lessThanEqual(r, Rgb(1.f)))))
-    throw Error(ps.loc_of("reflectance"), "reflectance must be in [0, 1] (energy would not be conserved)");
-  float eta = ps.get_float("eta");
-  if (!(eta > 0.f && std::isfinite(eta))) throw Error(ps.loc_of("eta"), "eta must be positive");
-  MicrofacetRoughness rough = microfacet_roughness(ctx);
-  warning(ctx.loc, "coateddiffuse is approximated by Disney's diffuse + clearcoat");
-  if (reflectance.is_constant() && rough.is_constant())
-    return new disney::DisneyBsdf(coated_params(r, microfacet_alphas(ps), eta));
-  auto params_at = [reflectance, rough, eta](const TextureEvalContext& tc) {
-    TrowbridgeReitz d = rough.at(tc);
-    return coated_params(glm::clamp(reflectance.evaluate(tc), Rgb(0.f), Rgb(1.f)), Vec2(d.alpha_x(), d.alpha_y()), eta);
-  };
-  // Diffuse and the glossy coat at every hit, whatever the textures give.
-  return new disney::TexturedDisneyBsdf(params_at, disney::DisneyBsdf(coated_params(Rgb(0.5f), Vec2(0.f), eta)).flags());
+  if (reflectance.is_constant()) {
+    Rgb r = reflectance.constant();
+    if (!(glm::all(glm::greaterThanEqual(r, Rgb(0.f))) && glm::all(glm::lessThanEqual(r, Rgb(1.f)))))
+      throw Error(ps.loc_of("reflectance"), "reflectance must be in [0, 1] (energy would not be conserved)");
+  }
+  float eta = checked_eta(ps, "eta");
+  MicrofacetRoughness rough = prefixed_roughness(ctx, "");
+  LayerInputs layer = layer_inputs(ctx);
+  if (!reflectance.is_constant() || !rough.is_constant() || !layer.is_constant())
+    return new TexturedCoatedDiffuseBsdf(reflectance, rough, eta, layer);
+  return new CoatedDiffuseBsdf(CoatedDiffuseBxdf(DielectricBxdf(eta, rough.at({})), DiffuseBxdf(reflectance.constant()),
+                                                 layer.at({})));
 }
 
 }  // namespace
 
-PENUMBRA_PLUGIN(Bsdf, "coateddiffuse", "diffuse base under a clear coat (approximated with Disney lobes)", kParams,
+PENUMBRA_PLUGIN(Bsdf, "coateddiffuse", "diffuse base under a dielectric coat (stochastic layered BxDF)", kParams,
                 create)

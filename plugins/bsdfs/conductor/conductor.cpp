@@ -1,4 +1,4 @@
-// Material "conductor": metal reflection, a Trowbridge-Reitz (GGX) microfacet BRDF with the exact
+// Material "conductor" (BxDF in libs/bxdf/conductor_bxdf.h): metal reflection, a Trowbridge-Reitz (GGX) microfacet BRDF with the exact
 // Fresnel equations of a complex index of refraction, f = D G F / (4 |cos_o cos_i|), sampled from
 // the visible normals. Below alpha 1e-3 it is a perfect mirror (a delta lobe). Two-sided.
 //
@@ -18,6 +18,9 @@
 // the roughnesses: float textures), as in pbrt-v4.
 // "rgb reflectance" is pbrt-v4's artist-friendly mode: eta = 1 and k = 2 sqrt(R) / sqrt(1 - R),
 // which makes the reflectance at normal incidence exactly R.
+#include <bxdf_bsdf.h>
+#include <conductor_bxdf.h>
+
 #include <penumbra/bsdf.h>
 #include <penumbra/microfacet.h>
 #include <penumbra/plugin.h>
@@ -25,76 +28,10 @@
 namespace {
 
 using namespace penumbra;
-
-class ConductorBsdf final : public Bsdf {
- public:
-  ConductorBsdf(TrowbridgeReitz distrib, Rgb eta, Rgb k) : distrib_(distrib), eta_(eta), k_(k) {}
-
-  uint32_t flags() const override {
-    return BsdfReflection | (distrib_.effectively_smooth() ? BsdfSpecular : BsdfGlossy);
-  }
-
-  Rgb f(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
-    if (!same_hemisphere(wo, wi) || distrib_.effectively_smooth()) return Rgb(0.f);
-    float cos_o = abs_cos_theta(wo), cos_i = abs_cos_theta(wi);
-    if (cos_o == 0.f || cos_i == 0.f) return Rgb(0.f);
-    std::optional<Vec3> wm = half_vector(wo, wi);
-    if (!wm) return Rgb(0.f);
-    Rgb F = fresnel_complex(std::abs(glm::dot(wo, *wm)), eta_, k_);
-    return distrib_.D(*wm) * distrib_.G(wo, wi) * F / (4.f * cos_o * cos_i);
-  }
-
-  std::optional<BsdfSample> sample_f(const Vec3& wo, float, Vec2 u, const ShadingContext& ctx) const override {
-    if (wo.z == 0.f) return std::nullopt;
-    if (distrib_.effectively_smooth()) {
-      // Delta reflection: the weight f |cos| / pdf must be F, so f carries F / |cos|.
-      Vec3 wi(-wo.x, -wo.y, wo.z);
-      float cos_i = abs_cos_theta(wi);
-      return BsdfSample{fresnel_complex(cos_i, eta_, k_) / cos_i, wi, 1.f, BsdfReflection | BsdfSpecular};
-    }
-    Vec3 wm = distrib_.sample_wm(wo, u);
-    Vec3 wi = reflect(wo, wm);
-    if (!same_hemisphere(wo, wi)) return std::nullopt;  // reflected into the microsurface
-    float pdf = distrib_.pdf(wo, wm) / (4.f * std::abs(glm::dot(wo, wm)));
-    if (!(pdf > 0.f) || wi.z == 0.f) return std::nullopt;
-    return BsdfSample{f(wo, wi, ctx), wi, pdf, BsdfReflection | BsdfGlossy};
-  }
-
-  float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext&) const override {
-    if (!same_hemisphere(wo, wi) || distrib_.effectively_smooth()) return 0.f;
-    std::optional<Vec3> wm = half_vector(wo, wi);
-    if (!wm) return 0.f;
-    // Reflection maps half vectors to directions with Jacobian 1 / (4 |wo . wm|).
-    return distrib_.pdf(wo, *wm) / (4.f * std::abs(glm::dot(wo, *wm)));
-  }
-
-  LobeSummary lobe(const Vec3& wo, const ShadingContext&) const override {
-    LobeSummary l;
-    l.peak = Vec3(-wo.x, -wo.y, wo.z);
-    l.alpha_x = distrib_.alpha_x();
-    l.alpha_y = distrib_.alpha_y();
-    l.coefficient = luminance(fresnel_complex(1.f, eta_, k_));
-    return l;
-  }
-
- private:
-  // Half vector of a reflection pair, on the +z side (the distribution's domain).
-  static std::optional<Vec3> half_vector(const Vec3& wo, const Vec3& wi) {
-    Vec3 wm = wo + wi;
-    if (glm::dot(wm, wm) == 0.f) return std::nullopt;
-    wm = glm::normalize(wm);
-    return wm.z < 0.f ? -wm : wm;
-  }
-
-  TrowbridgeReitz distrib_;
-  Rgb eta_, k_;
-};
-
-// R = 1 would need k = infinity; 0.9999 is indistinguishable and keeps Fresnel finite.
-Rgb k_from_reflectance(Rgb r) {
-  r = glm::clamp(r, Rgb(0.f), Rgb(0.9999f));
-  return 2.f * glm::sqrt(r) / glm::sqrt(Rgb(1.f) - r);
-}
+using bxdf::BxdfBsdf;
+using bxdf::ConductorBxdf;
+using bxdf::k_from_reflectance;
+using ConductorBsdf = BxdfBsdf<ConductorBxdf>;
 
 // Textured parameters: each call evaluates them at the hit and forwards to a ConductorBsdf made on
 // the stack (the constant material keeps its code and cost). Flags are the union over roughness.
@@ -108,9 +45,9 @@ class TexturedConductorBsdf final : public PerHitBsdf<TexturedConductorBsdf> {
 
  private:
   ConductorBsdf at(const ShadingContext& ctx) const {
-    if (reflectance_) return ConductorBsdf(r_.at(ctx.tex), Rgb(1.f), k_from_reflectance(reflectance_->evaluate(ctx.tex)));
-    return ConductorBsdf(r_.at(ctx.tex), glm::max(eta_.evaluate(ctx.tex), Rgb(1e-4f)),
-                         glm::max(k_.evaluate(ctx.tex), Rgb(0.f)));
+    if (reflectance_) return ConductorBsdf(ConductorBxdf(r_.at(ctx.tex), Rgb(1.f), k_from_reflectance(reflectance_->evaluate(ctx.tex))));
+    return ConductorBsdf(ConductorBxdf(r_.at(ctx.tex), glm::max(eta_.evaluate(ctx.tex), Rgb(1e-4f)),
+                                       glm::max(k_.evaluate(ctx.tex), Rgb(0.f))));
   }
   MicrofacetRoughness r_;
   TexturedRgb eta_, k_;
@@ -154,7 +91,7 @@ Object* create(const CreateContext& ctx) {
   if (!(eta.r > 0.f && eta.g > 0.f && eta.b > 0.f))
     throw Error(p.loc_of("eta"), "eta must be > 0 in every channel");
   if (!(k.r >= 0.f && k.g >= 0.f && k.b >= 0.f)) throw Error(p.loc_of("k"), "k must be >= 0 in every channel");
-  return new ConductorBsdf(TrowbridgeReitz(ur, vr), eta, k);
+  return new ConductorBsdf(ConductorBxdf(TrowbridgeReitz(ur, vr), eta, k));
 }
 
 }  // namespace

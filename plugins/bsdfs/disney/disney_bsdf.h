@@ -16,7 +16,7 @@
 // The clearcoat is never a delta: GTR1's alpha is at least 0.001 by its definition
 // (lerp(0.1, 0.001, clearcoatgloss)), a glossy lobe at any gloss.
 //
-// Shared by the "disney" and "coateddiffuse" plugins (both compile this file in).
+// Used by the "disney" plugin.
 #pragma once
 
 #include "disney_lobes.h"
@@ -37,7 +37,7 @@ struct DisneyParams {
   float sheen_tint = 0.5f;
   float clearcoat = 0.f;       // the coat's weight is 0.25 clearcoat
   float clearcoat_gloss = 1.f;
-  float clearcoat_r0 = 0.04f;  // Disney fixes IOR 1.5; coateddiffuse derives it from its eta
+  float clearcoat_r0 = 0.04f;  // Disney fixes IOR 1.5
   float spec_trans = 0.f;
   bool thin = false;
   float flatness = 0.f;

@@ -1,6 +1,6 @@
 // A Disney BSDF whose parameters come from textures: each call asks `params_at` for the hit's
 // DisneyParams and forwards to a DisneyBsdf made on the stack, so untextured materials keep the
-// plain DisneyBsdf and its cost. Shared by "disney" and "coateddiffuse" (which is built on it).
+// plain DisneyBsdf and its cost. Used by "disney".
 #pragma once
 
 #include "disney_bsdf.h"
