@@ -18,6 +18,9 @@
 #   --no-native     do not render Penumbra with the scene's own integrator (only with path)
 #   --out DIR       where the temporary scene copies and images go (default /tmp/penumbra-vs-pbrt-v4)
 #   --penumbra BIN  Penumbra binary (default: build/bin/penumbra of this checkout)
+#   --crop-top F    also compare the means of the images without their top fraction F (0 < F < 1): for
+#                   scenes whose mean is dominated by a tiny light seen directly (water-caustic: a few
+#                   camera samples per render hit it, so the full mean cannot agree at any practical spp)
 #
 # Each scene is rendered from a copy in DIR/<scene>/ (symlinks to the scene's folder contents plus a
 # rewritten scene file): the Film's resolution is replaced, nothing else. When the scene lights with a
@@ -33,7 +36,7 @@ set -u -o pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 pbrt="${PBRT:-}"
 if [[ $# -gt 0 && "$1" != -* && -x "$1" && ! -d "$1" && "$1" != *.pbrt ]]; then pbrt="$1"; shift; fi
-width=160 spp=64 threads=2 seed=1 noise=0 pbrtpath=0 native=1
+width=160 spp=64 threads=2 seed=1 noise=0 pbrtpath=0 native=1 croptop=""
 out=/tmp/penumbra-vs-pbrt-v4
 penumbra="$here/build/bin/penumbra"
 scenes=()
@@ -48,6 +51,7 @@ while [[ $# -gt 0 ]]; do
     --no-native) native=0; shift ;;
     --out) out="$2"; shift 2 ;;
     --penumbra) penumbra="$2"; shift 2 ;;
+    --crop-top) croptop="$2"; shift 2 ;;
     -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "unknown option $1" >&2; exit 2 ;;
     *) scenes+=("$1"); shift ;;
@@ -65,6 +69,11 @@ mkdir -p "$out"
 
 # Image mean per channel: "r g b".
 means() { oiiotool -v --stats "$1" 2>/dev/null | awk '/Stats Avg/ { print $3, $4, $5; exit }'; }
+# Mean per channel over the image without its top fraction $croptop.
+cropmeans() { local w h y0
+  read -r w h < <(oiiotool --info "$1" | sed -E 's/.*: *([0-9]+) x +([0-9]+),.*/\1 \2/')
+  y0=$(awk -v h="$h" -v f="$croptop" 'BEGIN { printf "%d", h * f + 0.5 }')
+  oiiotool "$1" --crop "${w}x$((h - y0))+0+$y0" -o "${1%.exr}-cropped.exr" && means "${1%.exr}-cropped.exr"; }
 # Ratio a/b per channel: "1.0123 0.9987 1.0034".
 ratios() { awk -v a="$1" -v b="$2" 'BEGIN { n = split(a, x, " "); split(b, y, " ");
   for (i = 1; i <= n; i++) printf "%s%.4f", (i > 1 ? " " : ""), (y[i] != 0 ? x[i] / y[i] : 0); }'; }
@@ -202,6 +211,20 @@ for entry in "${scenes[@]}"; do
     fi
   done
 
+  cropcol=""
+  if [[ -n "$croptop" && -n "$pm" ]]; then
+    cpm="$(cropmeans "$work/pbrt-$integ.exr")"
+    for run in "${runs[@]}"; do
+      [[ -f "$work/penumbra-$run.exr" ]] || continue
+      r="$(ratios "$(cropmeans "$work/penumbra-$run.exr")" "$cpm")"
+      echo "   without the top $croptop of the image: penumbra $run / pbrt-v4 = $r"
+      cropcol+=" $run $r;"
+      for f in "$work/penumbra-$run-seed"[0-9].exr "$work/penumbra-$run-seed"[0-9][0-9].exr; do
+        [[ -f "$f" ]] && echo "     seed $((seed + 1)): penumbra $run / pbrt-v4 = $(ratios "$(cropmeans "$f")" "$cpm")"
+      done
+    done
+  fi
+
   if [[ -n "$pm" && $pbrtpath -eq 1 && "$integ" != path ]]; then
     sed -E 's/^(\s*)Integrator\s+"[a-z]+"/\1Integrator "path"/' "$copy" | \
       grep -vE '"(float radius|integer photonsperiteration|integer seed|bool visualizestrategies|bool visualizeweights|string lightsampler|bool regularize)"' \
@@ -217,6 +240,7 @@ for entry in "${scenes[@]}"; do
   fi
   summary+=("$(printf '%-18s %-8s %-11s %-22s %-22s %-20s %s' "$tag" "$integ" "${w}x${h}/$sspp" "$pathratio" "$nativeratio" "$noisepath" "$noisenative")")
   [[ "$note" != "-" ]] && summary[-1]+="  (equal-area copy of the environment)"
+  [[ -n "$cropcol" ]] && summary+=("$(printf '%-18s without the top %s:%s' "" "$croptop" "$cropcol")")
 done
 
 echo

@@ -130,6 +130,7 @@ void SceneParser::take_graphics_state(ShapeEntity& s) const {
   s.medium_inside = state_.medium_inside;
   s.medium_outside = state_.medium_outside;
   s.medium_loc = state_.medium_loc;
+  s.object = current_object_;
 }
 
 // pbrt-v4: media are named globally, before or after WorldBegin, with their kind in "string type".

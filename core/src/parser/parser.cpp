@@ -17,7 +17,7 @@ namespace {
 // pbrt-v4 directives Penumbra knowingly leaves out: naming them gives a clear message instead of
 // "unknown directive".
 const std::set<std::string> kUnsupported = {
-    "ActiveTransform", "Attribute", "ObjectBegin", "ObjectEnd", "ObjectInstance", "TransformTimes",
+    "ActiveTransform", "Attribute", "TransformTimes",
 };
 
 
@@ -59,6 +59,9 @@ const std::map<std::string, SceneParser::Handler>& SceneParser::handlers() {
       {"Material", &SceneParser::material},
       {"MediumInterface", &SceneParser::medium_interface},
       {"NamedMaterial", &SceneParser::named_material},
+      {"ObjectBegin", &SceneParser::object_begin},
+      {"ObjectEnd", &SceneParser::object_end},
+      {"ObjectInstance", &SceneParser::object_instance},
       {"Option", &SceneParser::option},
       {"PixelFilter", &SceneParser::pixel_filter},
       {"ReverseOrientation", &SceneParser::reverse_orientation},
@@ -177,6 +180,9 @@ void SceneParser::include(const Token& d) {
 }
 
 void SceneParser::finish() {
+  if (current_object_ >= 0)
+    throw Error(desc_.objects[current_object_].loc,
+                fmt::format("ObjectBegin '{}' has no matching ObjectEnd", desc_.objects[current_object_].name));
   for (const auto& b : blocks_)
     warning(b.loc,
             fmt::format("{} has no matching {}", b.attribute ? "AttributeBegin" : "TransformBegin",
@@ -185,7 +191,48 @@ void SceneParser::finish() {
 
 void SceneParser::attribute_begin(const Token& d) { blocks_.push_back({true, d.loc, state_}); }
 
-void SceneParser::attribute_end(const Token& d) { close_block(d, true); }
+void SceneParser::attribute_end(const Token& d) {
+  if (current_object_ >= 0 && blocks_.size() == object_depth_)
+    throw Error(d.loc, fmt::format("AttributeEnd closes the ObjectBegin at {} (use ObjectEnd)",
+                                   desc_.objects[current_object_].loc.str()));
+  close_block(d, true);
+}
+
+// pbrt-v4: ObjectBegin opens an attribute block and ObjectEnd closes it; objects do not nest, and
+// instances are placed outside object definitions. Names are global; redefining one is an error.
+void SceneParser::object_begin(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "object name");
+  if (current_object_ >= 0)
+    throw Error(d.loc, fmt::format("ObjectBegin inside the definition of object '{}' (at {}): objects do not nest",
+                                   desc_.objects[current_object_].name, desc_.objects[current_object_].loc.str()));
+  for (const auto& o : desc_.objects)
+    if (o.name == name.text)
+      throw Error(name.loc, fmt::format("object '{}' redefined (first defined at {})", name.text, o.loc.str()));
+  desc_.objects.push_back(ObjectEntity{name.text, d.loc});
+  current_object_ = static_cast<int>(desc_.objects.size()) - 1;
+  blocks_.push_back({true, d.loc, state_});
+  object_depth_ = blocks_.size();
+}
+
+void SceneParser::object_end(const Token& d) {
+  require_world(d);
+  if (current_object_ < 0) throw Error(d.loc, "ObjectEnd without a matching ObjectBegin");
+  if (blocks_.size() != object_depth_)
+    throw Error(d.loc, fmt::format("ObjectEnd closes the {} at {}", blocks_.back().attribute ? "AttributeBegin" : "TransformBegin",
+                                   blocks_.back().loc.str()));
+  close_block(d, true);
+  current_object_ = -1;
+}
+
+void SceneParser::object_instance(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "object name");
+  if (current_object_ >= 0)
+    throw Error(d.loc, fmt::format("ObjectInstance inside the definition of object '{}': instances do not nest",
+                                   desc_.objects[current_object_].name));
+  desc_.instances.push_back(InstanceEntity{name.text, name.loc, Mat4(state_.ctm)});
+}
 
 void SceneParser::transform_begin(const Token& d) {
   warn_once(d, "TransformBegin is deprecated in pbrt-v4; use AttributeBegin");

@@ -31,6 +31,20 @@ struct ShapeEntity : SceneEntity {
   // MediumInterface in effect: named media inside and outside ("" = vacuum), and where it was set.
   std::string medium_inside, medium_outside;
   FileLoc medium_loc;
+  int object = -1;              // index into SceneDescription::objects when inside ObjectBegin
+};
+
+/// `ObjectBegin "name"` ... `ObjectEnd`: shapes placed by instances (pbrt-v4's object instancing).
+struct ObjectEntity {
+  std::string name;
+  FileLoc loc;
+};
+
+/// `ObjectInstance "name"`: the object placed with the transform current at the directive.
+struct InstanceEntity {
+  std::string name;
+  FileLoc loc;
+  Mat4 to_world{1.f};
 };
 
 /// `MakeNamedMedium "name" "string type" "homogeneous" ...`: type is the medium's "string type".
@@ -57,6 +71,8 @@ struct SceneDescription {
   std::vector<SceneEntity> lights;                // LightSource
   std::vector<SceneEntity> area_lights;           // AreaLightSource
   std::vector<ShapeEntity> shapes;
+  std::vector<ObjectEntity> objects;              // ObjectBegin, in file order
+  std::vector<InstanceEntity> instances;          // ObjectInstance
   std::vector<MediumEntity> media;                // MakeNamedMedium, in file order
   std::map<std::string, int> named_media;         // name -> index into media
   std::string camera_medium;                      // outside medium of the MediumInterface at Camera

@@ -91,6 +91,9 @@ class SceneParser {
   void shape(const Token& d);
   void take_graphics_state(ShapeEntity& s) const;  // material, area light, media
   void make_named_medium(const Token& d);
+  void object_begin(const Token& d);
+  void object_end(const Token& d);
+  void object_instance(const Token& d);
   void medium_interface(const Token& d);
   void texture(const Token& d);
   void reverse_orientation(const Token& d);
@@ -109,6 +112,8 @@ class SceneParser {
   std::vector<OpenBlock> blocks_;
   std::map<std::string, glm::dmat4> named_coordinate_systems_;
   bool in_world_ = false;
+  int current_object_ = -1;              // the ObjectBegin being read, or -1
+  size_t object_depth_ = 0;              // blocks_.size() just after that ObjectBegin
   FileLoc world_begin_loc_;
   std::set<std::string> warned_;
   std::vector<std::string> open_files_;  // canonical paths of the Include chain, for cycles

@@ -458,6 +458,8 @@ RenderResult render(const RenderSettings& settings) {
   s.threads = threads;
   s.seed = static_cast<uint32_t>(desc.sampler.params.get_int("seed", 0));
   s.triangles = built.scene->triangle_count();
+  s.instances = built.scene->instance_count();
+  s.instanced_triangles = built.scene->instanced_triangle_count();
   s.scene_hash = hash;
   s.first_sample = options.first_sample;
   s.spp_total = range.split ? range.total : s.spp;
@@ -504,6 +506,8 @@ std::string stats_json(const RenderStats& s) {
   j["threads"] = s.threads;
   j["seed"] = s.seed;
   j["triangles"] = s.triangles;
+  j["instances"] = s.instances;
+  j["instanced_triangles"] = s.instanced_triangles;
   j["scene_hash"] = s.scene_hash;
   j["spp_total"] = s.spp_total;
   j["first_sample"] = s.first_sample;

@@ -93,7 +93,9 @@ struct RenderStats {
   std::string integrator, sampler, scene_file, output;
   int threads = 0;
   uint32_t seed = 0;
-  size_t triangles = 0;
+  size_t triangles = 0;        // stored once (an instanced object's triangles count once)
+  size_t instances = 0;        // ObjectInstance placements
+  size_t instanced_triangles = 0;  // triangles as the instances place them
   std::string scene_hash;      // render_outputs.h
   int spp_total = 0;           // samples of the whole render this one is a part of (= spp unsplit)
   int first_sample = 0;        // index of this render's first sample

@@ -21,6 +21,7 @@ EmbreeScene::EmbreeScene() {
 }
 
 EmbreeScene::~EmbreeScene() {
+  for (Prototype& p : prototypes_) rtcReleaseScene(p.scene);
   if (scene_) rtcReleaseScene(scene_);
   if (device_) rtcReleaseDevice(device_);
 }
@@ -36,17 +37,19 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
     v[3 * i] = mesh->P[i].x;
     v[3 * i + 1] = mesh->P[i].y;
     v[3 * i + 2] = mesh->P[i].z;
-    bounds_.extend(mesh->P[i]);
+    target_bounds().extend(mesh->P[i]);
   }
   auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
                                                              RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
                                                              mesh->triangle_count()));
   std::copy(mesh->indices.begin(), mesh->indices.end(), idx);
   rtcCommitGeometry(geom);
-  unsigned id = rtcAttachGeometry(scene_, geom);
+  unsigned id = rtcAttachGeometry(target_scene(), geom);
   rtcReleaseGeometry(geom);
-  if (geometries_.size() <= id) geometries_.resize(id + 1);
-  geometries_[id] = Geometry{mesh.get(), nullptr, nullptr, bsdf, std::move(lights), textured, media};
+  std::vector<Geometry>& geometries = target_geometries();
+  if (geometries.size() <= id) geometries.resize(id + 1);
+  geometries[id] = Geometry{mesh.get(), nullptr, nullptr, bsdf, std::move(lights), textured, media};
+  if (target_ >= 0) prototypes_[target_].triangles += mesh->triangle_count();
   meshes_.push_back(std::move(mesh));
 }
 
@@ -57,15 +60,16 @@ void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, c
                                                         RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
   Vec3 c = sphere->center();
   v[0] = c.x, v[1] = c.y, v[2] = c.z, v[3] = sphere->radius();
-  bounds_.extend(c - Vec3(sphere->radius()));
-  bounds_.extend(c + Vec3(sphere->radius()));
+  target_bounds().extend(c - Vec3(sphere->radius()));
+  target_bounds().extend(c + Vec3(sphere->radius()));
   rtcCommitGeometry(geom);
-  unsigned id = rtcAttachGeometry(scene_, geom);
+  unsigned id = rtcAttachGeometry(target_scene(), geom);
   rtcReleaseGeometry(geom);
-  if (geometries_.size() <= id) geometries_.resize(id + 1);
+  std::vector<Geometry>& geometries = target_geometries();
+  if (geometries.size() <= id) geometries.resize(id + 1);
   std::vector<const Light*> lights;
   if (light) lights.push_back(light);
-  geometries_[id] = Geometry{nullptr, sphere.get(), nullptr, bsdf, std::move(lights), textured, media};
+  geometries[id] = Geometry{nullptr, sphere.get(), nullptr, bsdf, std::move(lights), textured, media};
   spheres_.push_back(std::move(sphere));
 }
 
@@ -108,12 +112,13 @@ void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf
   rtcSetGeometryIntersectFunction(geom, quadric_intersect);
   rtcSetGeometryOccludedFunction(geom, quadric_occluded);
   Bounds3 b = quadric->world_bounds();
-  bounds_.extend(b.min);
-  bounds_.extend(b.max);
+  target_bounds().extend(b.min);
+  target_bounds().extend(b.max);
   rtcCommitGeometry(geom);
-  unsigned id = rtcAttachGeometry(scene_, geom);
+  unsigned id = rtcAttachGeometry(target_scene(), geom);
   rtcReleaseGeometry(geom);
-  if (geometries_.size() <= id) geometries_.resize(id + 1);
+  std::vector<Geometry>& geometries = target_geometries();
+  if (geometries.size() <= id) geometries.resize(id + 1);
   std::vector<const Light*> lights;
   if (light) lights.push_back(light);
   Geometry g;
@@ -122,7 +127,7 @@ void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf
   g.lights = std::move(lights);
   g.textured = textured;
   g.media = media;
-  geometries_[id] = std::move(g);
+  geometries[id] = std::move(g);
   quadrics_.push_back(std::move(quadric));
 }
 
@@ -138,6 +143,53 @@ void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const
 }
 
 void EmbreeScene::commit() { rtcCommitScene(scene_); }
+
+int EmbreeScene::begin_prototype() {
+  if (target_ >= 0) throw Error("object definitions cannot nest");
+  Prototype p;
+  p.scene = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(p.scene, RTC_BUILD_QUALITY_HIGH);
+  prototypes_.push_back(std::move(p));
+  target_ = static_cast<int>(prototypes_.size()) - 1;
+  return target_;
+}
+
+void EmbreeScene::end_prototype() {
+  rtcCommitScene(prototypes_[target_].scene);
+  target_ = -1;
+}
+
+void EmbreeScene::add_instance(int prototype, const Mat4& to_world) {
+  const Prototype& proto = prototypes_.at(prototype);
+  if (proto.geometries.empty()) return;  // an empty object places nothing
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+  rtcSetGeometryInstancedScene(geom, proto.scene);
+  rtcSetGeometryTimeStepCount(geom, 1);
+  rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &to_world[0][0]);
+  rtcCommitGeometry(geom);
+  unsigned id = rtcAttachGeometry(scene_, geom);
+  rtcReleaseGeometry(geom);
+  if (instances_.size() <= id) instances_.resize(id + 1);
+  Instance inst;
+  inst.prototype = prototype;
+  inst.to_world = to_world;
+  inst.to_object = glm::inverse(to_world);
+  inst.normal_to_world = glm::transpose(glm::mat3(inst.to_object));
+  instances_[id] = inst;
+  ++instance_count_;
+  for (int k = 0; k < 8; ++k) {  // the prototype's box, placed
+    Vec3 c((k & 1) ? proto.bounds.max.x : proto.bounds.min.x, (k & 2) ? proto.bounds.max.y : proto.bounds.min.y,
+           (k & 4) ? proto.bounds.max.z : proto.bounds.min.z);
+    bounds_.extend(Vec3(to_world * Vec4(c, 1.f)));
+  }
+}
+
+size_t EmbreeScene::instanced_triangle_count() const {
+  size_t n = 0;
+  for (const Instance& inst : instances_)
+    if (inst.prototype >= 0) n += prototypes_[inst.prototype].triangles;
+  return n;
+}
 
 size_t EmbreeScene::triangle_count() const {
   size_t n = 0;
@@ -181,16 +233,19 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   rtcIntersect1(scene_, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
 
-  const Geometry& g = geometries_[rh.hit.geomID];
+  // A hit inside an instance is computed in the prototype's space and then placed.
+  const Instance* inst = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[rh.hit.instID[0]] : nullptr;
+  const Geometry& g = inst ? prototypes_[inst->prototype].geometries[rh.hit.geomID] : geometries_[rh.hit.geomID];
+  Ray local = inst ? Ray{Vec3(inst->to_object * Vec4(ray.o, 1.f)), glm::mat3(inst->to_object) * ray.d, ray.tmax} : ray;
   SurfaceInteraction si;
   si.t = rh.ray.tfar;
   si.wo = -glm::normalize(ray.d);
-  si.shape_id = rh.hit.geomID;
+  si.shape_id = inst ? rh.hit.instID[0] : rh.hit.geomID;
   si.prim_id = rh.hit.primID;
   si.bsdf = g.bsdf;
   si.media = g.media;
   if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? rh.hit.primID : 0];
-  Vec3 quadric_dpdu(0.f), quadric_dpdv(0.f);
+  Vec3 dpdu(0.f), dpdv(0.f);  // for texture footprints only
   if (g.mesh) {
     // The hit point comes from the barycentrics: its error does not grow with t.
     Vec3 b(1.f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v);
@@ -200,33 +255,49 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
     si.ng = s.ng;
     si.ns = s.ns;
     si.uv = s.uv;
+    if (g.textured) g.mesh->uv_derivatives(rh.hit.primID, &dpdu, &dpdv);
   } else if (g.quadric) {
-    Quadric::Surface s = g.quadric->surface_at(ray, si.t);
-    quadric_dpdu = s.dpdu;
-    quadric_dpdv = s.dpdv;
+    Quadric::Surface s = g.quadric->surface_at(local, si.t);
+    dpdu = s.dpdu;
+    dpdv = s.dpdv;
     si.p = s.p;
     si.p_error = s.p_error;
     si.ng = si.ns = s.n;
     si.uv = s.uv;
   } else {
-    si.p = g.sphere->reproject(ray.o + si.t * ray.d);
+    si.p = g.sphere->reproject(local.o + si.t * local.d);
     si.p_error = error_gamma(5) * glm::abs(si.p);
     si.ng = si.ns = g.sphere->normal_at(si.p);
     si.uv = g.sphere->uv_at(si.p);
+    if (g.textured) g.sphere->uv_derivatives(si.p, &dpdu, &dpdv);
+  }
+  if (inst) {
+    place_instanced_hit(si, *inst);
+    dpdu = glm::mat3(inst->to_world) * dpdu;
+    dpdv = glm::mat3(inst->to_world) * dpdv;
   }
   si.shading = Frame(si.ns);
-  if (g.textured) add_texture_footprint(si, g, quadric_dpdu, quadric_dpdv);
+  if (g.textured) add_texture_footprint(si, g, dpdu, dpdv);
   return si;
+}
+
+// Point, normals and the error bound from the prototype's space to the world, as pbrt-v4 transforms
+// an instance's SurfaceInteraction (normals by the inverse transpose). The error bound is the
+// transformed bound plus the rounding of the transform itself.
+void EmbreeScene::place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const {
+  Vec3 p = Vec3(inst.to_world * Vec4(si.p, 1.f));
+  glm::mat3 abs_m(glm::abs(glm::mat3(inst.to_world)[0]), glm::abs(glm::mat3(inst.to_world)[1]),
+                  glm::abs(glm::mat3(inst.to_world)[2]));
+  Vec3 t = glm::abs(Vec3(inst.to_world[3]));
+  si.p_error = (1.f + error_gamma(3)) * (abs_m * si.p_error) + error_gamma(3) * (abs_m * glm::abs(si.p) + t);
+  si.p = p;
+  si.ng = glm::normalize(inst.normal_to_world * si.ng);
+  si.ns = glm::normalize(inst.normal_to_world * si.ns);
 }
 
 // pbrt-v4's differentials without ray differentials: the camera estimates how far p moves per
 // pixel, and (du, dv) follow from dp = du dpdu + dv dpdv by least squares in the tangent plane.
-void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Geometry& g, const Vec3& quadric_dpdu,
-                                        const Vec3& quadric_dpdv) const {
-  Vec3 dpdu, dpdv;
-  if (g.mesh) g.mesh->uv_derivatives(si.prim_id, &dpdu, &dpdv);
-  else if (g.sphere) g.sphere->uv_derivatives(si.p, &dpdu, &dpdv);
-  else dpdu = quadric_dpdu, dpdv = quadric_dpdv;
+void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Geometry&, Vec3 dpdu, Vec3 dpdv) const {
   camera_->approximate_dp_dxy(si.p, si.ng, &si.dpdx, &si.dpdy);
   si.dpdx *= footprint_scale_;
   si.dpdy *= footprint_scale_;

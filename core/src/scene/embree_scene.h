@@ -37,6 +37,15 @@ class EmbreeScene final : public Scene {
   void set_texture_footprint_scale(float s) { footprint_scale_ = s; }
   void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light, bool textured = false,
                    MediumInterface media = {});
+  /// Object instancing (pbrt-v4's ObjectBegin/ObjectInstance through Embree instances: one copy of
+  /// the geometry however many instances). Between begin_prototype() and end_prototype() the add_*
+  /// calls build prototype `id` (no area lights) instead of the scene; add_instance() places it.
+  int begin_prototype();
+  void end_prototype();
+  void add_instance(int prototype, const Mat4& to_world);
+  size_t instance_count() const { return instance_count_; }
+  /// Triangles as the instances place them (each instance counts its prototype's again).
+  size_t instanced_triangle_count() const;
   /// Absorption coefficients of the media that geometry names by index.
   void set_media(std::vector<Rgb> sigma_a) { media_sigma_a_ = std::move(sigma_a); }
   bool has_media() const override { return !media_sigma_a_.empty(); }
@@ -73,8 +82,28 @@ class EmbreeScene final : public Scene {
     bool textured = false;
     MediumInterface media;
   };
-  void add_texture_footprint(SurfaceInteraction& si, const Geometry& g, const Vec3& quadric_dpdu,
-                             const Vec3& quadric_dpdv) const;
+  struct Prototype {
+    RTCScene scene = nullptr;
+    std::vector<Geometry> geometries;  // indexed by Embree geometry id in `scene`
+    Bounds3 bounds;
+    size_t triangles = 0;
+  };
+  struct Instance {
+    int prototype = -1;  // -1: the top-level geometry of this id is not an instance
+    Mat4 to_world{1.f}, to_object{1.f};
+    glm::mat3 normal_to_world{1.f};
+  };
+  // Where add_* put geometry: the scene, or the prototype being built.
+  RTCScene target_scene() const { return target_ < 0 ? scene_ : prototypes_[target_].scene; }
+  std::vector<Geometry>& target_geometries() { return target_ < 0 ? geometries_ : prototypes_[target_].geometries; }
+  Bounds3& target_bounds() { return target_ < 0 ? bounds_ : prototypes_[target_].bounds; }
+  void add_texture_footprint(SurfaceInteraction& si, const Geometry& g, Vec3 dpdu, Vec3 dpdv) const;
+  void place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const;
+
+  std::vector<Prototype> prototypes_;
+  std::vector<Instance> instances_;  // indexed by Embree geometry id in scene_
+  int target_ = -1;
+  size_t instance_count_ = 0;
 
   std::vector<Rgb> media_sigma_a_;
   RTCDevice device_ = nullptr;

@@ -339,13 +339,13 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     }
     out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s));
   };
-  for (auto& s : desc.shapes) {
+  auto add_shape = [&](ShapeEntity& s) {
     if (!material_of(s)) {  // "interface": no surface, rays pass
       if (s.area_light >= 0) throw Error(s.loc, "an area light on a shape with material 'interface' is not supported");
       if (media.interface_of(s).is_transition())
         throw Error(s.loc, "a shape with material 'interface' that bounds a medium is not supported yet (give it a "
                            "dielectric material with eta 1 to bound the medium)");
-      continue;
+      return;
     }
     if (s.type == "trianglemesh" || s.type == "plymesh") {
       const Bsdf* bsdf = material_of(s);
@@ -380,7 +380,31 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       throw Error(s.loc, fmt::format("unsupported shape '{}'; available: cylinder, disk, gltf, plymesh, sphere, trianglemesh",
                                      s.type));
     }
+  };
+  for (auto& s : desc.shapes)
+    if (s.object < 0) add_shape(s);
+  // Object instancing: each object's shapes become one Embree prototype, placed by its instances.
+  std::vector<int> prototype_of(desc.objects.size(), -1);
+  for (size_t k = 0; k < desc.objects.size(); ++k) {
+    prototype_of[k] = out.scene->begin_prototype();
+    for (auto& s : desc.shapes) {
+      if (s.object != static_cast<int>(k)) continue;
+      if (s.area_light >= 0)
+        throw Error(s.loc, fmt::format("an area light in object '{}' (ObjectBegin at {}) is not supported, as in "
+                                       "pbrt-v4: instanced shapes cannot emit",
+                                       desc.objects[k].name, desc.objects[k].loc.str()));
+      add_shape(s);
+    }
+    out.scene->end_prototype();
   }
+  for (const InstanceEntity& inst : desc.instances) {
+    auto it = std::find_if(desc.objects.begin(), desc.objects.end(),
+                           [&](const ObjectEntity& o) { return o.name == inst.name; });
+    if (it == desc.objects.end())
+      throw Error(inst.loc, fmt::format("ObjectInstance of '{}', which no ObjectBegin defines", inst.name));
+    out.scene->add_instance(prototype_of[it - desc.objects.begin()], inst.to_world);
+  }
+  if (!desc.instances.empty()) out.structures_built.push_back("embree_instances");
   out.scene->adopt_shapes(std::move(light_triangles));
   if (!media.sigma_a().empty()) out.structures_built.push_back("absorbing_media");
   out.scene->set_media(media.sigma_a());
