@@ -96,8 +96,8 @@ TEST(ParserErrors, UnknownDirectiveSuggestsTheClosestOne) {
 }
 
 TEST(ParserErrors, UnsupportedDirectiveNamesTheDocs) {
-  expect_error("WorldBegin\nObjectBegin \"tree\"", 2, 1,
-               "unsupported directive 'ObjectBegin' (Penumbra supports a subset of pbrt-v4: see "
+  expect_error("WorldBegin\nTransformTimes 0 1", 2, 1,
+               "unsupported directive 'TransformTimes' (Penumbra supports a subset of pbrt-v4: see "
                "docs/scene-format.md)");
 }
 
