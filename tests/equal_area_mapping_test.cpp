@@ -1,8 +1,8 @@
-// The equal-area octahedral map (libs/environment-map/equal_area.h): known points, round trips to
+// The equal-area octahedral map (penumbra/equal_area.h): known points, round trips to
 // 1e-5, equal solid angle per cell of the square (exactly, as spherical polygons, and statistically,
 // by a chi-square test of the histogram of uniform directions), and the border wrap; each property
 // with a negative control (a map 1-2 % off equal area, a wrong wrap) that fails.
-#include "equal_area.h"
+#include <penumbra/equal_area.h>
 
 #include <penumbra/sampling.h>
 
@@ -18,9 +18,6 @@
 namespace penumbra {
 namespace {
 
-using envmap::equal_area_sphere_to_square;
-using envmap::equal_area_square_to_sphere;
-using envmap::wrap_equal_area_square;
 using SquareToSphere = std::function<Vec3(Vec2)>;
 using SphereToSquare = std::function<Vec2(const Vec3&)>;
 

@@ -1,6 +1,6 @@
 #include "environment_map.h"
 
-#include "equal_area.h"
+#include <penumbra/equal_area.h>
 
 #include <algorithm>
 #include <cmath>

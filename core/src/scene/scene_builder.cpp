@@ -6,6 +6,7 @@
 #include "scene/media.h"
 #include "scene/orthographic_camera.h"
 #include "scene/perspective_camera.h"
+#include "scene/spherical_camera.h"
 
 #include <penumbra/memory.h>
 
@@ -239,9 +240,12 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   } else if (desc.camera.type == "orthographic") {
     desc.camera.params.validate(orthographic_camera_params(), "camera 'orthographic'");
     camera = std::make_unique<OrthographicCamera>(desc.camera.params, desc.camera.to_world, res);
+  } else if (desc.camera.type == "spherical") {
+    desc.camera.params.validate(spherical_camera_params(), "camera 'spherical'");
+    camera = std::make_unique<SphericalCamera>(desc.camera.params, desc.camera.to_world, res, desc.camera.loc);
   } else {
-    throw Error(desc.camera.loc,
-                fmt::format("unsupported camera '{}'; available: orthographic, perspective", desc.camera.type));
+    throw Error(desc.camera.loc, fmt::format("unsupported camera '{}'; available: orthographic, perspective, spherical",
+                                             desc.camera.type));
   }
 
   // Sampler and integrator plugins.

@@ -1,6 +1,7 @@
 // Clarberg's equal-area octahedral map between the unit square and the unit sphere, the
 // parameterisation pbrt-v4 uses for environment images ("Fast Equal-Area Mapping of the (Hemi)Sphere
-// using SIMD", Journal of Graphics Tools 13(3), 2008). docs/environment-maps.md derives it.
+// using SIMD", Journal of Graphics Tools 13(3), 2008), used by environment images and the spherical
+// camera. docs/environment-maps.md derives it.
 //
 // The square [0,1]^2 is moved to [-1,1]^2 with coordinates (a, b). The diamond |a| + |b| <= 1 holds
 // the hemisphere z >= 0, the four corner triangles outside it hold z < 0; the corners are -z. With
@@ -11,7 +12,7 @@
 
 #include <penumbra/math.h>
 
-namespace penumbra::envmap {
+namespace penumbra {
 
 /// Direction (unit length) of a point of [0,1]^2.
 Vec3 equal_area_square_to_sphere(Vec2 p);
@@ -26,4 +27,4 @@ Vec2 equal_area_sphere_to_square(const Vec3& d);
 /// filters and pixel footprints that reach over the border.
 Vec2 wrap_equal_area_square(Vec2 p);
 
-}  // namespace penumbra::envmap
+}  // namespace penumbra

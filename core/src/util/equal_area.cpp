@@ -1,6 +1,6 @@
-#include "equal_area.h"
+#include <penumbra/equal_area.h>
 
-namespace penumbra::envmap {
+namespace penumbra {
 
 Vec3 equal_area_square_to_sphere(Vec2 p) {
   float a = 2.f * p.x - 1.f, b = 2.f * p.y - 1.f;
@@ -47,4 +47,4 @@ Vec2 wrap_equal_area_square(Vec2 p) {
   return p;
 }
 
-}  // namespace penumbra::envmap
+}  // namespace penumbra
