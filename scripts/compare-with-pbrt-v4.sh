@@ -67,6 +67,16 @@ if [[ ${#scenes[@]} -eq 0 ]]; then
 fi
 mkdir -p "$out"
 
+# Run Penumbra (log file, then its arguments). A crash or a missing binary is retried twice after
+# 30 s: the build directory may be being rebuilt while the comparison runs.
+runpen() { local log="$1" rc try; shift
+  for try in 1 2 3; do
+    if [[ -x "$penumbra" ]]; then "$penumbra" "$@" >"$log" 2>&1; rc=$?; else rc=127; fi
+    [[ $rc -lt 126 ]] && return $rc
+    echo "   (penumbra exit status $rc, attempt $try: retrying in 30 s)" >&2; sleep 30
+  done
+  return $rc; }
+
 # Image mean per channel: "r g b".
 means() { oiiotool -v --stats "$1" 2>/dev/null | awk '/Stats Avg/ { print $3, $4, $5; exit }'; }
 # Mean per channel over the image without its top fraction $croptop.
@@ -184,7 +194,7 @@ for entry in "${scenes[@]}"; do
     img="$work/penumbra-$run.exr"; t0=$SECONDS
     args=(render "$copy" -o "$img" --spp "$sspp" --res "${w}x${h}" --nthreads "$threads" --seed "$seed" -q)
     [[ "$run" == path ]] && args+=(--integrator path --param "maxdepth=$maxdepth")
-    "$penumbra" "${args[@]}" >"$work/penumbra-$run.log" 2>&1; rc=$?
+    runpen "$work/penumbra-$run.log" "${args[@]}"; rc=$?
     if [[ $rc -eq 0 ]]; then
       m="$(means "$img")"; msg="   penumbra $run: mean $m ($((SECONDS - t0)) s)"
       if [[ -n "$pm" ]]; then
@@ -198,7 +208,7 @@ for entry in "${scenes[@]}"; do
           [[ "${args2[$i]}" == "$img" ]] && args2[$i]="$img2"
           [[ $i -gt 0 && "${args2[$((i - 1))]}" == --seed ]] && args2[$i]="$((seed + 1))"
         done
-        if "$penumbra" "${args2[@]}" >/dev/null 2>&1; then
+        if runpen "$work/penumbra-$run-seed$((seed + 1)).log" "${args2[@]}"; then
           r="$(ratios "$(means "$img2")" "$m")"
           n="$(awk -v r="$r" 'BEGIN { n = split(r, x, " ");
             for (i = 1; i <= n; i++) printf "%s%+.2f", (i > 1 ? " " : ""), 100 * (x[i] - 1); }')"

@@ -103,7 +103,7 @@ TEST(ParserErrors, UnsupportedDirectiveNamesTheDocs) {
 
 TEST(ParserErrors, EveryUnsupportedPbrtDirectiveIsNamedAsSuch) {
   for (const char* d :
-       {"ActiveTransform", "Attribute", "TransformTimes"}) {
+       {"ActiveTransform", "TransformTimes"}) {
     SCOPED_TRACE(d);
     expect_error(fmt::format("WorldBegin\n {}", d), 2, 2,
                  fmt::format("unsupported directive '{}'", d));

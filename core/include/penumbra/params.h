@@ -42,6 +42,8 @@ struct Param {
                                      // of a spectrum or blackbody (converted when the scene is read)
   std::vector<std::string> strings;  // string values
   std::vector<bool> bools;           // bool values
+  bool from_attribute = false;       // a default from pbrt-v4's `Attribute` directive: dropped, not an
+                                     // error, when the object has no parameter of that name
   size_t count() const { return numbers.size() + strings.size() + bools.size(); }
 };
 

@@ -16,7 +16,7 @@
 // 7: texture plugins (PluginKind::Texture, texture.h); ShadingContext carries a TextureEvalContext;
 //    SurfaceInteraction gained a pixel footprint; Camera::approximate_dp_dxy().
 // 8: absorbing media: SurfaceInteraction::media (MediumInterface), Scene::has_media(),
-//    Scene::transmittance().
+//    Scene::transmittance(); Param::from_attribute.
 #define PENUMBRA_SDK_VERSION 8
 #endif
 

@@ -5,6 +5,8 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+
 #include "parser/param_list.h"
 #include "parser/spectrum_params.h"
 
@@ -22,9 +24,22 @@ SceneEntity SceneParser::make_entity(const Token& d, const char* what) {
   return entity_at(d, std::move(type), parse_param_list(*tok_));
 }
 
+// The Attribute target whose defaults a directive takes ("" for none).
+static const char* attribute_target(const std::string& directive) {
+  if (directive == "Shape") return "shape";
+  if (directive == "LightSource" || directive == "AreaLightSource") return "light";
+  if (directive == "Material" || directive == "MakeNamedMaterial") return "material";
+  if (directive == "MakeNamedMedium") return "medium";
+  if (directive == "Texture") return "texture";
+  return "";
+}
+
 SceneEntity SceneParser::entity_at(const Token& d, std::string type, ParamSet params) {
   SceneEntity e;
   e.type = std::move(type);
+  if (auto it = state_.attributes.find(attribute_target(d.text)); it != state_.attributes.end())
+    for (const Param& p : it->second.params())
+      if (!params.has(p.name)) params.add(p);  // keeps the Attribute's location for errors
   e.params = resolve_spectra(params, spectrum_use_of(d.text), base_dir_);
   e.loc = d.loc;
   e.base_dir = base_dir_;
@@ -120,6 +135,27 @@ void SceneParser::shape(const Token& d) {
   static_cast<SceneEntity&>(s) = make_entity(d, "shape type");
   take_graphics_state(s);
   desc_.shapes.push_back(std::move(s));
+}
+
+// pbrt-v4's `Attribute "target" params`: defaults for the shapes, lights, materials, media or
+// textures that follow in the attribute block; a later Attribute of the same parameter replaces it.
+void SceneParser::attribute(const Token& d) {
+  Token target = expect_string(d, "attribute target (\"shape\", \"light\", \"material\", \"medium\" or \"texture\")");
+  static const char* const kTargets[] = {"shape", "light", "material", "medium", "texture"};
+  if (std::find(std::begin(kTargets), std::end(kTargets), target.text) == std::end(kTargets))
+    throw Error(target.loc, fmt::format("unknown attribute target \"{}\"; available: light, material, medium, shape, "
+                                        "texture",
+                                        target.text));
+  ParamSet given = parse_param_list(*tok_);
+  ParamSet& defaults = state_.attributes[target.text];
+  ParamSet merged;
+  for (const Param& p : defaults.params())
+    if (!given.has(p.name)) merged.add(p);
+  for (Param p : given.params()) {
+    p.from_attribute = true;
+    merged.add(std::move(p));
+  }
+  defaults = std::move(merged);
 }
 
 void SceneParser::take_graphics_state(ShapeEntity& s) const {

@@ -17,7 +17,7 @@ namespace {
 // pbrt-v4 directives Penumbra knowingly leaves out: naming them gives a clear message instead of
 // "unknown directive".
 const std::set<std::string> kUnsupported = {
-    "ActiveTransform", "Attribute", "TransformTimes",
+    "ActiveTransform", "TransformTimes",
 };
 
 
@@ -40,6 +40,7 @@ const std::map<std::string, SceneParser::Handler>& SceneParser::handlers() {
   static const std::map<std::string, Handler> table = {
       {"Accelerator", &SceneParser::accelerator},
       {"AreaLightSource", &SceneParser::area_light_source},
+      {"Attribute", &SceneParser::attribute},
       {"AttributeBegin", &SceneParser::attribute_begin},
       {"AttributeEnd", &SceneParser::attribute_end},
       {"Camera", &SceneParser::camera},

@@ -26,6 +26,9 @@ struct GraphicsState {
   int area_light = -1;
   std::string medium_inside, medium_outside;  // MediumInterface ("" = vacuum)
   FileLoc medium_loc;
+  // Attribute "shape"|"light"|"material"|"medium"|"texture": defaults for the parameters of the
+  // directives of that kind that follow (a directive's own parameters win).
+  std::map<std::string, ParamSet> attributes;
 };
 
 class SceneParser {
@@ -94,6 +97,7 @@ class SceneParser {
   void object_begin(const Token& d);
   void object_end(const Token& d);
   void object_instance(const Token& d);
+  void attribute(const Token& d);
   void medium_interface(const Token& d);
   void texture(const Token& d);
   void reverse_orientation(const Token& d);

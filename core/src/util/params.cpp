@@ -112,6 +112,10 @@ void ParamSet::validate(std::span<const ParamSpec> spec, const std::string& what
   for (const auto& s : spec)
     if (s.default_value && *s.default_value && std::string(s.type) != "unsupported")
       defaults_.push_back(parse_default(s));
+  auto known = [&](const Param& p) {
+    return std::any_of(spec.begin(), spec.end(), [&](const ParamSpec& s) { return p.name == s.name; });
+  };
+  std::erase_if(params_, [&](const Param& p) { return p.from_attribute && !known(p); });
   for (const auto& p : params_) {
     const ParamSpec* match = nullptr;
     for (const auto& s : spec)
