@@ -38,6 +38,8 @@ struct CreateContext {
   std::string scene_dir;          // folder of the scene file, for relative file names
   Mat4 to_world{1.f};             // transform in effect at the directive (lights)
   const Shape* shape = nullptr;   // area lights: the primitive they are attached to
+  float shape_area = 0.f;         // area lights: the area of the whole shape (all of a mesh's
+                                  // triangles), for pbrt-v4's "power"
   bool reverse_orientation = false;
   const TextureTable* textures = nullptr;  // named textures defined so far (materials, textures)
   bool spectrum_texture = false;  // texture plugins: the directive asked for "spectrum" (else "float")

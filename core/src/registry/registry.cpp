@@ -145,8 +145,12 @@ Object* Registry::create_object(const LoadedPlugin& plugin, ParamSet& params, Cr
   const PluginInfo& info = *plugin.info;
   params.validate({info.params, info.param_count},
                   fmt::format("{} '{}'", plugin_kind_name(info.kind), info.name));
-  CreateContext full{params,     loc,          ctx.scene_dir,    ctx.to_world, ctx.shape,
-                     ctx.reverse_orientation, ctx.textures, ctx.spectrum_texture};
+  // The caller's context with the validated parameters and the location (every other field copied).
+  CreateContext full{params, loc, ctx.scene_dir, ctx.to_world, ctx.shape};
+  full.shape_area = ctx.shape_area;
+  full.reverse_orientation = ctx.reverse_orientation;
+  full.textures = ctx.textures;
+  full.spectrum_texture = ctx.spectrum_texture;
   Object* obj = info.create(full);
   if (!obj) throw Error(loc, fmt::format("{} '{}' could not be created", plugin_kind_name(info.kind), info.name));
   return obj;

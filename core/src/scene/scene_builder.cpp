@@ -314,12 +314,13 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   // Shapes and the area lights on them.
   out.scene = std::make_unique<EmbreeScene>();
   std::vector<const Light*> all_lights, infinite_lights;
-  auto make_area_light = [&](const ShapeEntity& s, const Shape* shape) -> const Light* {
+  // `shape_area`: the whole shape's (a mesh's triangles together), for pbrt-v4's "power".
+  auto make_area_light = [&](const ShapeEntity& s, const Shape* shape, float shape_area) -> const Light* {
     SceneEntity& a = desc.area_lights[s.area_light];
-    auto light = registry.create<Light>(PluginKind::Light, a.type, a.params,
-                                        CreateContext{a.params, {}, a.base_dir, a.to_world, shape,
-                                                      s.reverse_orientation},
-                                        a.loc);
+    CreateContext ctx{a.params, {}, a.base_dir, a.to_world, shape};
+    ctx.reverse_orientation = s.reverse_orientation;
+    ctx.shape_area = shape_area;
+    auto light = registry.create<Light>(PluginKind::Light, a.type, a.params, ctx, a.loc);
     if (light->type() != LightType::Area)
       throw Error(a.loc, fmt::format("light '{}' is not an area light", a.type));
     out.lights.push_back(std::move(light));
@@ -332,13 +333,15 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
                       bool is_textured) {
     std::vector<const Light*> lights;
     if (s.area_light >= 0) {
+      float total_area = 0.f;
+      for (uint32_t i = 0; i < mesh->triangle_count(); ++i) total_area += mesh->area(i);
       for (uint32_t i = 0; i < mesh->triangle_count(); ++i) {
         if (mesh->area(i) <= 0.f) {  // degenerate: never hit, never sampled
           lights.push_back(nullptr);
           continue;
         }
         light_triangles.push_back(std::make_unique<Triangle>(mesh.get(), i));
-        lights.push_back(make_area_light(s, light_triangles.back().get()));
+        lights.push_back(make_area_light(s, light_triangles.back().get(), total_area));
       }
     }
     out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s));
@@ -367,7 +370,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     } else if (s.type == "sphere") {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Sphere> sphere = load_sphere(s);
-      const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get()) : nullptr;
+      const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get(), sphere->area()) : nullptr;
       out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s), media.interface_of(s));
     } else if (s.type == "disk" || s.type == "cylinder") {
       const Bsdf* bsdf = material_of(s);
@@ -377,7 +380,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         if (!quadric->area_is_uniform())
           throw Error(s.loc, "a cylinder area light whose transform stretches its cross-section unevenly is not "
                              "supported (its emission could not be sampled uniformly by area)");
-        light = make_area_light(s, quadric.get());
+        light = make_area_light(s, quadric.get(), quadric->area());
       }
       out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s));
     } else {

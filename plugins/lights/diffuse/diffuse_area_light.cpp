@@ -74,7 +74,7 @@ const ParamSpec kParams[] = {
     {"float", "scale", "1", "multiplies L"},
     {"bool", "twosided", "false", "emit from both sides of the surface"},
     {"unsupported", "filename", "", "image-textured emitters are not supported"},
-    {"unsupported", "power", "", "give the radiance L instead"},
+    {"float", "power", "", "pbrt-v4's: scales L by power / (pi area (2 if two-sided)) over the whole shape"},
 };
 
 Object* create(const CreateContext& ctx) {
@@ -82,7 +82,14 @@ Object* create(const CreateContext& ctx) {
   Rgb L = ctx.params.get_rgb("L") * ctx.params.get_float("scale");
   if (!(L.r >= 0.f && L.g >= 0.f && L.b >= 0.f) || !is_finite(L))
     throw Error(ctx.params.loc_of("L"), "emitted radiance must be finite and non-negative");
-  return new DiffuseAreaLight(ctx.shape, L, ctx.params.get_bool("twosided"));
+  bool two_sided = ctx.params.get_bool("twosided");
+  if (const ParamSet& p = ctx.params; p.has("power")) {
+    float target = p.get_float("power");
+  if (!(target > 0.f) || !std::isfinite(target)) throw Error(p.loc_of("power"), "power must be finite and > 0");
+    float area = ctx.shape_area > 0.f ? ctx.shape_area : ctx.shape->area();
+    if (area > 0.f) L *= target / (Pi * area * (two_sided ? 2.f : 1.f));
+  }
+  return new DiffuseAreaLight(ctx.shape, L, two_sided);
 }
 
 }  // namespace

@@ -52,7 +52,7 @@ const ParamSpec kParams[] = {
     {"float", "scale", "1", "multiplies L"},
     {"point3", "from", "0 0 0", "the light travels from this point ..."},
     {"point3", "to", "0 0 1", "... towards this one"},
-    {"unsupported", "illuminance", "", "give the radiance L instead"},
+    {"float", "illuminance", "", "pbrt-v4's: scales L by illuminance (the irradiance of L's colour at luminance 1)"},
 };
 
 Object* create(const CreateContext& ctx) {
@@ -60,6 +60,11 @@ Object* create(const CreateContext& ctx) {
   Rgb L = p.get_rgb("L") * p.get_float("scale");
   if (!(L.r >= 0.f && L.g >= 0.f && L.b >= 0.f) || !is_finite(L))
     throw Error(p.loc_of("L"), "radiance must be finite and non-negative");
+  if (p.has("illuminance")) {
+    float target = p.get_float("illuminance");
+  if (!(target > 0.f) || !std::isfinite(target)) throw Error(p.loc_of("illuminance"), "illuminance must be finite and > 0");
+    L *= target;
+  }
   Vec3 w = glm::mat3(ctx.to_world) * (p.get_point3("from") - p.get_point3("to"));
   if (glm::length(w) == 0.f) throw Error(ctx.loc, "distant light: \"from\" and \"to\" are the same point");
   return new DistantLight(glm::normalize(w), L);

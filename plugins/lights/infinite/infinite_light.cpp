@@ -159,7 +159,8 @@ const ParamSpec kParams[] = {
     {"string", "mapping", "", "Penumbra: \"equalarea\" or \"equirectangular\" (default: equal area for a square "
                               "image, equirectangular with a warning for a 2:1 one)"},
     {"float", "scale", "1", "multiplies the radiance"},
-    {"unsupported", "illuminance", "", "give the radiance scale instead"},
+    {"float", "illuminance", "", "pbrt-v4's: scales the radiance so that the light-space upper hemisphere (+z) "
+                                 "gives this illuminance on a surface facing +z"},
     {"unsupported", "portal", "", "portals are not supported"},
 };
 
@@ -190,6 +191,22 @@ Mapping choose_mapping(const CreateContext& ctx, const std::string& path, const 
   return *m;
 }
 
+// Illuminance on a surface facing light-space +z: the sum over texels of luminance * cos(theta) *
+// solid angle, for texels whose centre is above the horizon (as pbrt-v4 sums it).
+double upper_hemisphere_illuminance(const ImageRgb& image, Mapping mapping) {
+  double e = 0.0;
+  for (int y = 0; y < image.height; ++y) {
+    double omega = envmap::texel_solid_angle(mapping, image.width, image.height, y);
+    for (int x = 0; x < image.width; ++x) {
+      Vec3 w = envmap::uv_to_direction(mapping, Vec2((x + 0.5f) / image.width, (y + 0.5f) / image.height));
+      if (w.z <= 0.f) continue;
+      const float* t = &image.pixels[3 * (size_t(y) * image.width + x)];
+      e += luminance(Rgb(t[0], t[1], t[2])) * w.z * omega;
+    }
+  }
+  return e;
+}
+
 Object* create(const CreateContext& ctx) {
   float scale = ctx.params.get_float("scale");
   if (!(scale >= 0.f) || !std::isfinite(scale)) throw Error(ctx.params.loc_of("scale"), "scale must be finite and >= 0");
@@ -216,6 +233,16 @@ Object* create(const CreateContext& ctx) {
   Rgb L = ctx.params.get_rgb("L");
   if (!(L.r >= 0.f && L.g >= 0.f && L.b >= 0.f) || !is_finite(L))
     throw Error(ctx.params.loc_of("L"), "radiance must be finite and non-negative");
+  if (ctx.params.has("illuminance")) {
+    float target = ctx.params.get_float("illuminance");
+    if (!(target > 0.f) || !std::isfinite(target))
+      throw Error(ctx.params.loc_of("illuminance"), "illuminance must be finite and > 0");
+    // pbrt-v4: a constant light's colour counts at luminance 1 (its hemisphere gives pi); an image
+    // counts by the luminance its texels send onto a +z-facing surface.
+    double k = file.empty() ? Pi : upper_hemisphere_illuminance(image, mapping);
+    if (!(k > 0.0)) throw Error(ctx.params.loc_of("illuminance"), "the image sends no light from its upper hemisphere");
+    scale *= static_cast<float>(target / k);
+  }
   return new InfiniteLight(ctx.to_world, L, std::move(image), mapping, scale);
 }
 

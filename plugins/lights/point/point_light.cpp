@@ -42,13 +42,18 @@ const ParamSpec kParams[] = {
     {"rgb", "I", "1 1 1", "radiant intensity"},
     {"float", "scale", "1", "multiplies I"},
     {"point3", "from", "0 0 0", "position"},
-    {"unsupported", "power", "", "give the intensity I instead"},
+    {"float", "power", "", "pbrt-v4's: scales I by power / (4 pi) (the flux of I's colour at luminance 1)"},
 };
 
 Object* create(const CreateContext& ctx) {
   Rgb I = ctx.params.get_rgb("I") * ctx.params.get_float("scale");
   if (!(I.r >= 0.f && I.g >= 0.f && I.b >= 0.f) || !is_finite(I))
     throw Error(ctx.params.loc_of("I"), "intensity must be finite and non-negative");
+  if (const ParamSet& p = ctx.params; p.has("power")) {
+    float target = p.get_float("power");
+  if (!(target > 0.f) || !std::isfinite(target)) throw Error(p.loc_of("power"), "power must be finite and > 0");
+    I *= target / (4.f * Pi);
+  }
   Vec3 from = Vec3(ctx.to_world * Vec4(ctx.params.get_point3("from"), 1.f));
   return new PointLight(from, I);
 }

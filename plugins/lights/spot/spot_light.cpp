@@ -63,7 +63,7 @@ const ParamSpec kParams[] = {
     {"point3", "to", "0 0 1", "a point on the cone's axis"},
     {"float", "coneangle", "30", "half angle of the cone in degrees"},
     {"float", "conedelta", "5", "width of the falloff band in degrees"},
-    {"unsupported", "power", "", "give the intensity I instead"},
+    {"float", "power", "", "pbrt-v4's: scales I by power over the cone's solid angle (falloff counted half)"},
     {"unsupported", "illuminance", "", "give the intensity I instead"},
 };
 
@@ -75,10 +75,16 @@ Object* create(const CreateContext& ctx) {
   float cone = p.get_float("coneangle"), delta = p.get_float("conedelta");
   if (!(cone > 0.f && cone <= 180.f)) throw Error(p.loc_of("coneangle"), "coneangle must be in (0, 180]");
   if (!(delta >= 0.f && delta <= cone)) throw Error(p.loc_of("conedelta"), "conedelta must be in [0, coneangle]");
+  float cos_start = std::cos(radians(cone - delta)), cos_end = std::cos(radians(cone));
+  if (p.has("power")) {
+    float target = p.get_float("power");
+  if (!(target > 0.f) || !std::isfinite(target)) throw Error(p.loc_of("power"), "power must be finite and > 0");
+    I *= target / (2.f * Pi * ((1.f - cos_start) + (cos_start - cos_end) / 2.f));
+  }
   Vec3 from = Vec3(ctx.to_world * Vec4(p.get_point3("from"), 1.f));
   Vec3 to = Vec3(ctx.to_world * Vec4(p.get_point3("to"), 1.f));
   if (from == to) throw Error(ctx.loc, "spot light: \"from\" and \"to\" are the same point");
-  return new SpotLight(from, glm::normalize(to - from), I, std::cos(radians(cone - delta)), std::cos(radians(cone)));
+  return new SpotLight(from, glm::normalize(to - from), I, cos_start, cos_end);
 }
 
 }  // namespace
