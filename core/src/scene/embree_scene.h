@@ -7,8 +7,10 @@
 #include <penumbra/sampling.h>
 #include <penumbra/scene.h>
 
+#include "scene/alpha_cutout.h"
 #include "scene/quadrics.h"
 #include "scene/sphere.h"
+#include "scene/surface_detail.h"
 #include "scene/triangle_mesh.h"
 
 #include <embree3/rtcore.h>
@@ -17,6 +19,12 @@
 #include <vector>
 
 namespace penumbra {
+
+/// What a shape's material and the shape itself add to its hits: bump or normal map, alpha cut-out.
+struct SurfaceOptions {
+  SurfaceDetail detail;
+  AlphaCutout cutout;
+};
 
 class EmbreeScene final : public Scene {
  public:
@@ -29,14 +37,14 @@ class EmbreeScene final : public Scene {
   /// material is `textured` get uv derivatives and a pixel footprint (SurfaceInteraction::dpdx ...).
   /// `media`: the media on the geometry's two sides (indices into set_media()'s table).
   void add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf, std::vector<const Light*> lights,
-                bool textured = false, MediumInterface media = {});
+                bool textured = false, MediumInterface media = {}, const SurfaceOptions& options = {});
   void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured = false,
-                  MediumInterface media = {});
+                  MediumInterface media = {}, const SurfaceOptions& options = {});
   /// Multiplies the texture footprint: pbrt-v4's max(1/8, 1/sqrt(spp)), since many samples per pixel
   /// already average what a wider filter would. 1 until set.
   void set_texture_footprint_scale(float s) { footprint_scale_ = s; }
   void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light, bool textured = false,
-                   MediumInterface media = {});
+                   MediumInterface media = {}, const SurfaceOptions& options = {});
   /// Absorption coefficients of the media that geometry names by index.
   void set_media(std::vector<Rgb> sigma_a) { media_sigma_a_ = std::move(sigma_a); }
   bool has_media() const override { return !media_sigma_a_.empty(); }
@@ -72,9 +80,12 @@ class EmbreeScene final : public Scene {
     std::vector<const Light*> lights;    // per primitive, or empty
     bool textured = false;
     MediumInterface media;
+    SurfaceDetail detail;
   };
-  void add_texture_footprint(SurfaceInteraction& si, const Geometry& g, const Vec3& quadric_dpdu,
-                             const Vec3& quadric_dpdv) const;
+  void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;
+  const GeometryUserData* keep_user_data(GeometryUserData data);
+  static ShadingGeometry shading_geometry(const Geometry& g, const SurfaceInteraction& si, const Vec3& dpdu,
+                                          const Vec3& dpdv);
 
   std::vector<Rgb> media_sigma_a_;
   RTCDevice device_ = nullptr;
@@ -84,6 +95,7 @@ class EmbreeScene final : public Scene {
   std::vector<std::unique_ptr<Quadric>> quadrics_;
   std::vector<std::unique_ptr<Triangle>> light_shapes_;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
+  std::vector<std::unique_ptr<GeometryUserData>> user_data_;  // Embree callbacks' (quadrics, cut-outs)
   std::vector<const Light*> lights_, infinite_;
   Distribution1D light_distribution_;  // over lights_, proportional to luminance of power
   std::unique_ptr<Camera> camera_;

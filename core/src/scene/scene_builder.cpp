@@ -6,6 +6,7 @@
 #include "scene/media.h"
 #include "scene/orthographic_camera.h"
 #include "scene/perspective_camera.h"
+#include "scene/surface_params.h"
 
 #include <penumbra/memory.h>
 
@@ -25,13 +26,13 @@ const ParamSpec kTriangleMeshParams[] = {
     {"point2[]", "uv", "", "per-vertex texture coordinates"},
     {"unsupported", "S", "", "tangents are not used"},
     {"unsupported", "faceIndices", "", ""},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 const ParamSpec kPlyMeshParams[] = {
     {"string", "filename", "", "PLY file (ASCII or binary; triangles and polygons)"},
-    {"unsupported", "displacement", "", "displacement is not supported"},
-    {"unsupported", "edgelength", "", "displacement is not supported"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"unsupported", "displacement", "", "displacement of PLY meshes is not supported (bump maps are: give the material \"texture displacement\")"},
+    {"unsupported", "edgelength", "", "displacement of PLY meshes is not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 const ParamSpec kGltfParams[] = {
     {"string", "filename", "", "glTF 2.0 file (.gltf or .glb): all triangle meshes of its default scene"},
@@ -41,7 +42,7 @@ const ParamSpec kSphereParams[] = {
     {"float", "zmin", "", "must cover the full sphere (partial spheres are not supported)"},
     {"float", "zmax", "", "must cover the full sphere (partial spheres are not supported)"},
     {"float", "phimax", "360", "must be 360 (partial spheres are not supported)"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 
 const ParamSpec kDiskParams[] = {
@@ -49,14 +50,14 @@ const ParamSpec kDiskParams[] = {
     {"float", "radius", "1", "outer radius"},
     {"float", "innerradius", "0", "inner radius (an annulus when > 0)"},
     {"float", "phimax", "360", "largest azimuth in degrees (a sector when < 360)"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 const ParamSpec kCylinderParams[] = {
     {"float", "radius", "1", "radius in object space"},
     {"float", "zmin", "-1", "lower end along z"},
     {"float", "zmax", "1", "upper end along z"},
     {"float", "phimax", "360", "largest azimuth in degrees"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 
 std::string resolve(const std::string& base_dir, const std::string& file) {
@@ -258,29 +259,58 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   // order; the default material only if some shape needs it.
   build_textures(desc, registry, out);
   std::vector<bool> material_textured;
+  std::vector<SurfaceDetail> material_detail;  // bump and normal maps, taken off the plugins' parameters
   for (auto& m : desc.materials) {
     if (m.type.empty()) throw Error(m.loc, "material has no type");
     if (is_composite_material(m.type)) {  // "mix" and "interface": built below from the others
       out.bsdfs.push_back(nullptr);
       material_textured.push_back(true);  // its parts may be textured: give its hits a footprint
+      material_detail.emplace_back();
       continue;
     }
+    material_detail.push_back(take_surface_detail(m.params, m.base_dir, out.texture_table));
     CreateContext ctx{m.params, {}, m.base_dir};
     ctx.textures = &out.texture_table;
     out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params, ctx, m.loc));
-    material_textured.push_back(uses_textures(m.params));
+    // A bump map evaluates its texture over the pixel footprint too.
+    material_textured.push_back(uses_textures(m.params) || material_detail.back().bump);
+  }
+  // A mix picks one of its materials per lookup, not per hit: their bump and normal maps cannot follow.
+  for (auto& m : desc.materials) {
+    const Param* names = m.type == "mix" ? m.params.find("materials") : nullptr;
+    if (!names) continue;
+    for (const std::string& name : names->strings)
+      if (auto it = desc.named_materials.find(name); it != desc.named_materials.end() && material_detail[it->second].any())
+        throw Error(names->loc, fmt::format("material '{}' has a bump or normal map: mixing it is not supported", name));
   }
   build_composite_materials(desc, out.bsdfs);
   const Bsdf* default_bsdf = nullptr;
   ParamSet default_params;
-  auto textured = [&](const ShapeEntity& s) {
+  auto material_index = [&](const ShapeEntity& s) {
     int i = s.material;
     if (i < 0 && !s.material_name.empty()) {
       auto it = desc.named_materials.find(s.material_name);
       i = it == desc.named_materials.end() ? -1 : it->second;
     }
+    return i;
+  };
+  auto textured = [&](const ShapeEntity& s) {
+    int i = material_index(s);
     return i >= 0 && material_textured[i];
   };
+  // The material's bump or normal map (unless a glTF primitive brings its own material) and the
+  // shape's alpha; a constant alpha of 0 drops the shape, as pbrt-v4 does.
+  auto surface_options = [&](const ShapeEntity& s, bool scene_material) {
+    SurfaceOptions o;
+    int i = material_index(s);
+    if (i >= 0 && scene_material) o.detail = material_detail[i];
+    o.cutout = shape_alpha(s.params, s.base_dir, out.texture_table);
+    if (o.cutout.active() && s.area_light >= 0)
+      throw Error(s.params.loc_of("alpha"), "alpha on a shape with an area light is not supported (its emission "
+                                            "would have to be cut out of light sampling too)");
+    return o;
+  };
+  auto invisible = [](const SurfaceOptions& o) { return o.cutout.alpha.is_constant() && o.cutout.alpha.constant() <= 0.f; };
   auto material_of = [&](const ShapeEntity& s) -> const Bsdf* {
     if (s.material >= 0) return out.bsdfs[s.material].get();
     if (!s.material_name.empty()) {
@@ -325,7 +355,9 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   MediaTable media(desc);
   std::vector<std::unique_ptr<Triangle>> light_triangles;
   auto add_mesh = [&](const ShapeEntity& s, std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
-                      bool is_textured) {
+                      bool is_textured, bool scene_material = true) {
+    SurfaceOptions options = surface_options(s, scene_material);
+    if (invisible(options)) return;
     std::vector<const Light*> lights;
     if (s.area_light >= 0) {
       for (uint32_t i = 0; i < mesh->triangle_count(); ++i) {
@@ -337,7 +369,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         lights.push_back(make_area_light(s, light_triangles.back().get()));
       }
     }
-    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s));
+    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s), options);
   };
   for (auto& s : desc.shapes) {
     if (!material_of(s)) {  // "interface": no surface, rays pass
@@ -358,16 +390,20 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       for (GltfPrimitive& g : load_gltf(resolve(s.base_dir, file), loc)) {
         const Bsdf* bsdf = g.material ? gltf_bsdf(*g.material, s.loc) : material_of(s);
         add_mesh(s, make_mesh(s, std::move(g.P), std::move(g.indices), std::move(g.N), std::move(g.uv), loc, loc, loc), bsdf,
-                 !g.material && textured(s));
+                 !g.material && textured(s), !g.material);
       }
     } else if (s.type == "sphere") {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Sphere> sphere = load_sphere(s);
+      SurfaceOptions options = surface_options(s, true);
+      if (invisible(options)) continue;
       const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get()) : nullptr;
-      out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s), media.interface_of(s));
+      out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s), media.interface_of(s), options);
     } else if (s.type == "disk" || s.type == "cylinder") {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Quadric> quadric = load_quadric(s);
+      SurfaceOptions options = surface_options(s, true);
+      if (invisible(options)) continue;
       const Light* light = nullptr;
       if (s.area_light >= 0) {
         if (!quadric->area_is_uniform())
@@ -375,7 +411,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
                              "supported (its emission could not be sampled uniformly by area)");
         light = make_area_light(s, quadric.get());
       }
-      out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s));
+      out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s), options);
     } else {
       throw Error(s.loc, fmt::format("unsupported shape '{}'; available: cylinder, disk, gltf, plymesh, sphere, trianglemesh",
                                      s.type));
