@@ -24,6 +24,9 @@ namespace penumbra {
 struct SurfaceOptions {
   SurfaceDetail detail;
   AlphaCutout cutout;
+  /// Build the shading frame from dp/du (pbrt-v4's) rather than from the normal alone: for anisotropic
+  /// materials. Hits that are textured or bump/normal-mapped get it anyway.
+  bool tangent_frame = false;
 };
 
 class EmbreeScene final : public Scene {
@@ -81,6 +84,7 @@ class EmbreeScene final : public Scene {
     bool textured = false;
     MediumInterface media;
     SurfaceDetail detail;
+    bool tangent_frame = false;  // textured, detailed or asked for by SurfaceOptions
   };
   void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;
   const GeometryUserData* keep_user_data(GeometryUserData data);

@@ -142,6 +142,18 @@ std::unique_ptr<Sphere> load_sphere(ShapeEntity& e) {
   return std::make_unique<Sphere>(m, r, e.reverse_orientation != swaps_handedness(m));
 }
 
+// pbrt-v4's anisotropic roughness parameters ("uroughness", "conductor.vroughness", Disney's
+// "anisotropic"): such materials need the shading frame oriented by dp/du.
+bool anisotropic(const ParamSet& params) {
+  auto ends_with = [](const std::string& s, const char* tail) {
+    size_t n = std::char_traits<char>::length(tail);
+    return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
+  };
+  for (const auto& p : params.params())
+    if (ends_with(p.name, "uroughness") || ends_with(p.name, "vroughness") || p.name == "anisotropic") return true;
+  return false;
+}
+
 bool uses_textures(const ParamSet& params) {
   for (const auto& p : params.params())
     if (p.type == "texture") return true;
@@ -260,15 +272,18 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   build_textures(desc, registry, out);
   std::vector<bool> material_textured;
   std::vector<SurfaceDetail> material_detail;  // bump and normal maps, taken off the plugins' parameters
+  std::vector<bool> material_anisotropic;
   for (auto& m : desc.materials) {
     if (m.type.empty()) throw Error(m.loc, "material has no type");
     if (is_composite_material(m.type)) {  // "mix" and "interface": built below from the others
       out.bsdfs.push_back(nullptr);
       material_textured.push_back(true);  // its parts may be textured: give its hits a footprint
       material_detail.emplace_back();
+      material_anisotropic.push_back(true);  // its parts may be
       continue;
     }
     material_detail.push_back(take_surface_detail(m.params, m.base_dir, out.texture_table));
+    material_anisotropic.push_back(anisotropic(m.params));
     CreateContext ctx{m.params, {}, m.base_dir};
     ctx.textures = &out.texture_table;
     out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params, ctx, m.loc));
@@ -303,7 +318,10 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   auto surface_options = [&](const ShapeEntity& s, bool scene_material) {
     SurfaceOptions o;
     int i = material_index(s);
-    if (i >= 0 && scene_material) o.detail = material_detail[i];
+    if (i >= 0 && scene_material) {
+      o.detail = material_detail[i];
+      o.tangent_frame = material_anisotropic[i];
+    }
     o.cutout = shape_alpha(s.params, s.base_dir, out.texture_table);
     if (o.cutout.active() && s.area_light >= 0)
       throw Error(s.params.loc_of("alpha"), "alpha on a shape with an area light is not supported (its emission "
