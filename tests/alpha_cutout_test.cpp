@@ -91,6 +91,15 @@ TEST(AlphaCutout, HalfAlphaShowsHalfTheEmitter) {
   ImageRgb tex = render_text("alpha-half-tex",
                              front_quad("\"texture alpha\" \"h\"", "Texture \"h\" \"float\" \"constant\" \"float value\" [ 0.5 ]", 64, 64));
   EXPECT_NEAR(test::mean_channel(tex, 0), 0.5, tol);
+  // The same through the intersection callbacks of a disk (covering the view) and the filters of a
+  // sphere of radius 0.9 (covering f = pi 0.81 / 4 of the view, seen through its two layers, which
+  // decide independently: 0.5^2 of the emitter behind it, 1 - 0.75 f in all).
+  ImageRgb disk = render_text("alpha-half-disk", front_quad("\"float alpha\" [ 0.5 ]", "", 64, 64,
+                                                            "Shape \"disk\" \"float radius\" [ 2 ]"));
+  EXPECT_NEAR(test::mean_channel(disk, 0), 0.5, tol);
+  ImageRgb sphere = render_text("alpha-half-sphere", front_quad("\"float alpha\" [ 0.5 ]", "", 64, 64,
+                                                                "Shape \"sphere\" \"float radius\" [ 0.9 ]"));
+  EXPECT_NEAR(test::mean_channel(sphere, 0), 1.0 - 0.75 * Pi * 0.81 / 4.0, tol);
   ImageRgb control = render_text("alpha-half-control", front_quad("\"float alpha\" [ 0.49 ]", "", 64, 64));
   EXPECT_GT(std::abs(test::mean_channel(control, 0) - 0.5), tol);
 }

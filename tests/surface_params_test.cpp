@@ -84,3 +84,37 @@ TEST(SurfaceDetailErrors, EveryMaterialAcceptsTheCoreParameters) {
               "no error");
   }
 }
+
+namespace {
+
+// A quad in z = 0 whose uv is rotated by 45 degrees, seen head-on.
+SurfaceInteraction rotated_uv_hit(const std::string& material) {
+  Registry registry(Registry::default_search_dirs());
+  SceneDescription d = parse_scene_string("LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n" + material +
+                                              "\nShape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ]"
+                                              " \"integer indices\" [ 0 1 2  0 2 3 ] \"point2 uv\" [ 0.5 0  1 0.5  0.5 1  0 0.5 ]\n",
+                                          "frame.pbrt");
+  BuiltScene b = build_scene(d, registry);
+  auto si = b.scene->intersect(Ray{Vec3(0.1f, 0.2f, -5.f), Vec3(0.f, 0.f, 1.f)});
+  EXPECT_TRUE(si.has_value());
+  return si.value_or(SurfaceInteraction{});
+}
+
+}  // namespace
+
+// Anisotropic roughness is oriented by dp/du, as in pbrt-v4: the frame's s is u's direction on the
+// surface, (1, -1, 0) / sqrt 2 here (u = 0 at (-1, 1), 1 at (1, -1)). An isotropic material keeps the normal-only frame, whose s is (1, 0, 0)
+// on this quad (the control: it is 45 degrees away).
+TEST(SurfaceDetailFrames, AnisotropicMaterialsGetTheDpduFrame) {
+  const Vec3 u_dir = glm::normalize(Vec3(1.f, -1.f, 0.f));
+  for (const char* m : {"Material \"conductor\" \"float uroughness\" [ 0.1 ] \"float vroughness\" [ 0.4 ]",
+                        "Material \"coatedconductor\" \"float conductor.uroughness\" [ 0.1 ]",
+                        "Material \"disney\" \"float anisotropic\" [ 0.5 ]"}) {
+    SCOPED_TRACE(m);
+    SurfaceInteraction si = rotated_uv_hit(m);
+    EXPECT_NEAR(glm::dot(si.shading.s, u_dir), 1.f, 1e-6f);
+    EXPECT_NEAR(glm::length(si.shading.t - glm::cross(si.shading.n, si.shading.s)), 0.f, 1e-6f);
+  }
+  SurfaceInteraction iso = rotated_uv_hit("Material \"conductor\" \"float roughness\" [ 0.1 ]");
+  EXPECT_LT(glm::dot(iso.shading.s, u_dir), 0.8f);
+}

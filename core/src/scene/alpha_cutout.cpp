@@ -25,6 +25,10 @@ bool AlphaCutout::keeps(const TextureEvalContext& ctx, const Vec3& o, const Vec3
   return alpha_hash(o, d, salt) <= a;
 }
 
+uint64_t hit_salt(unsigned geom, unsigned prim, float t) {
+  return hash_ints((uint64_t(geom) << 32) | prim, std::bit_cast<uint32_t>(t));
+}
+
 namespace {
 
 // The hit's lookup context (no footprint: pbrt-v4 tests alpha before differentials exist).
@@ -57,7 +61,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     float t = RTCRayN_tfar(ray, N, i);
     unsigned prim = RTCHitN_primID(hit, N, i), geom = RTCHitN_geomID(hit, N, i);
     TextureEvalContext ctx = hit_context(*g, o, d, t, RTCHitN_u(hit, N, i), RTCHitN_v(hit, N, i), prim);
-    if (!g->cutout.keeps(ctx, o, d, (uint64_t(geom) << 32) | prim)) args->valid[i] = 0;
+    if (!g->cutout.keeps(ctx, o, d, hit_salt(geom, prim, t))) args->valid[i] = 0;
   }
 }
 
@@ -69,14 +73,14 @@ void set_alpha_filters(RTCGeometry geom, const GeometryUserData* data) {
   rtcSetGeometryOccludedFilterFunction(geom, alpha_filter<true>);
 }
 
-bool quadric_hit_kept(const GeometryUserData& data, const Ray& ray, float t, unsigned prim) {
+bool quadric_hit_kept(const GeometryUserData& data, const Ray& ray, float t, uint64_t salt) {
   if (!data.cutout.active()) return true;
   Quadric::Surface s = data.quadric->surface_at(ray, t);
   TextureEvalContext ctx;
   ctx.p = s.p;
   ctx.n = s.n;
   ctx.uv = s.uv;
-  return data.cutout.keeps(ctx, ray.o, ray.d, prim);
+  return data.cutout.keeps(ctx, ray.o, ray.d, salt);
 }
 
 }  // namespace penumbra

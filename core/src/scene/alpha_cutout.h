@@ -1,8 +1,8 @@
 // Alpha cut-outs on shapes (pbrt-v4's "float alpha" / "texture alpha"): a hit where alpha is 0 is
 // ignored by every ray (camera, bounce, shadow), one where it is 1 counts, and in between it counts
 // with probability alpha, decided by a hash of the ray's origin and direction (pbrt-v4's HashFloat)
-// and of the primitive, so that the same ray always decides the same way and stacked layers decide
-// independently. Triangle meshes and spheres test it in Embree intersection and occlusion filters;
+// and of the hit (primitive and distance), so that the same ray always decides the same way and
+// stacked layers decide independently. Triangle meshes and spheres test it in Embree intersection and occlusion filters;
 // disks and cylinders in their own intersection callbacks.
 #pragma once
 
@@ -42,7 +42,11 @@ struct GeometryUserData {
 /// `data` has an active cut-out (data must outlive the scene).
 void set_alpha_filters(RTCGeometry geom, const GeometryUserData* data);
 
-/// For user geometry: whether the quadric's hit at t of the ray counts.
-bool quadric_hit_kept(const GeometryUserData& data, const Ray& ray, float t, unsigned prim);
+/// What identifies a hit besides its ray: geometry, primitive and distance (a sphere or cylinder can be
+/// hit twice along a ray, and each layer decides on its own, as pbrt-v4's re-traced rays do).
+uint64_t hit_salt(unsigned geom, unsigned prim, float t);
+
+/// For user geometry: whether the quadric's hit at t of the ray counts (`salt`: hit_salt()).
+bool quadric_hit_kept(const GeometryUserData& data, const Ray& ray, float t, uint64_t salt);
 
 }  // namespace penumbra

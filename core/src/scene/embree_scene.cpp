@@ -100,7 +100,7 @@ static std::optional<float> first_kept_hit(const GeometryUserData& data, const R
                                            unsigned geom_id) {
   for (int k = 0; k < 4; ++k) {
     auto t = data.quadric->intersect(ray, t_min, t_max);
-    if (!t || quadric_hit_kept(data, ray, *t, uint64_t(geom_id) << 32)) return t;
+    if (!t || quadric_hit_kept(data, ray, *t, hit_salt(geom_id, 0, *t))) return t;
     t_min = *t;
   }
   return std::nullopt;
