@@ -136,14 +136,24 @@ Rgb LayeredBxdf<Bottom>::f_walk(const Vec3& wo, const Vec3& wi, TransportMode mo
   return f;
 }
 
-template <class Bottom>
-Rgb LayeredBxdf<Bottom>::f(const Vec3& wo_in, const Vec3& wi_in, TransportMode mode, Pcg32& rng) const {
-  Vec3 wo = wo_in, wi = wi_in;
+namespace {
+
+// Two-sided as pbrt-v4: a wo below the surface mirrors both directions to the upper side. False
+// when the pair is not a reflection there (the base is opaque: the layers only reflect).
+bool to_upper_side(Vec3& wo, Vec3& wi) {
   if (wo.z < 0.f) {
     wo = -wo;
     wi = -wi;
   }
-  if (!(wo.z > 0.f && wi.z > 0.f)) return Rgb(0.f);  // the base is opaque: reflection only
+  return wo.z > 0.f && wi.z > 0.f;
+}
+
+}  // namespace
+
+template <class Bottom>
+Rgb LayeredBxdf<Bottom>::f(const Vec3& wo_in, const Vec3& wi_in, TransportMode mode, Pcg32& rng) const {
+  Vec3 wo = wo_in, wi = wi_in;
+  if (!to_upper_side(wo, wi)) return Rgb(0.f);
   Rgb f = top_.f(wo, wi, mode) * static_cast<float>(p_.n_samples);
   for (int s = 0; s < p_.n_samples; ++s) f += f_walk(wo, wi, mode, rng);
   return f / static_cast<float>(p_.n_samples);
@@ -355,11 +365,7 @@ float LayeredBxdf<Bottom>::pdf_walk(const Vec3& wo, const Vec3& wi, TransportMod
 template <class Bottom>
 float LayeredBxdf<Bottom>::pdf(const Vec3& wo_in, const Vec3& wi_in, TransportMode mode, Pcg32& rng) const {
   Vec3 wo = wo_in, wi = wi_in;
-  if (wo.z < 0.f) {
-    wo = -wo;
-    wi = -wi;
-  }
-  if (!(wo.z > 0.f && wi.z > 0.f)) return 0.f;
+  if (!to_upper_side(wo, wi)) return 0.f;
   float p = 0.f;
   for (int s = 0; s < p_.n_samples; ++s) p += pdf_walk(wo, wi, mode, rng);
   return top_.pdf(wo, wi, mode) + p / static_cast<float>(p_.n_samples);

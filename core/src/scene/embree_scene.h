@@ -7,8 +7,10 @@
 #include <penumbra/sampling.h>
 #include <penumbra/scene.h>
 
+#include "scene/alpha_cutout.h"
 #include "scene/quadrics.h"
 #include "scene/sphere.h"
+#include "scene/surface_detail.h"
 #include "scene/triangle_mesh.h"
 
 #include <embree3/rtcore.h>
@@ -17,6 +19,15 @@
 #include <vector>
 
 namespace penumbra {
+
+/// What a shape's material and the shape itself add to its hits: bump or normal map, alpha cut-out.
+struct SurfaceOptions {
+  SurfaceDetail detail;
+  AlphaCutout cutout;
+  /// Build the shading frame from dp/du (pbrt-v4's) rather than from the normal alone: for anisotropic
+  /// materials. Hits that are textured or bump/normal-mapped get it anyway.
+  bool tangent_frame = false;
+};
 
 class EmbreeScene final : public Scene {
  public:
@@ -29,14 +40,14 @@ class EmbreeScene final : public Scene {
   /// material is `textured` get uv derivatives and a pixel footprint (SurfaceInteraction::dpdx ...).
   /// `media`: the media on the geometry's two sides (indices into set_media()'s table).
   void add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf, std::vector<const Light*> lights,
-                bool textured = false, MediumInterface media = {});
+                bool textured = false, MediumInterface media = {}, const SurfaceOptions& options = {});
   void add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured = false,
-                  MediumInterface media = {});
+                  MediumInterface media = {}, const SurfaceOptions& options = {});
   /// Multiplies the texture footprint: pbrt-v4's max(1/8, 1/sqrt(spp)), since many samples per pixel
   /// already average what a wider filter would. 1 until set.
   void set_texture_footprint_scale(float s) { footprint_scale_ = s; }
   void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light, bool textured = false,
-                   MediumInterface media = {});
+                   MediumInterface media = {}, const SurfaceOptions& options = {});
   /// Object instancing (pbrt-v4's ObjectBegin/ObjectInstance through Embree instances: one copy of
   /// the geometry however many instances). Between begin_prototype() and end_prototype() the add_*
   /// calls build prototype `id` (no area lights) instead of the scene; add_instance() places it.
@@ -81,6 +92,8 @@ class EmbreeScene final : public Scene {
     std::vector<const Light*> lights;    // per primitive, or empty
     bool textured = false;
     MediumInterface media;
+    SurfaceDetail detail;
+    bool tangent_frame = false;  // textured, detailed or asked for by SurfaceOptions
   };
   struct Prototype {
     RTCScene scene = nullptr;
@@ -97,8 +110,11 @@ class EmbreeScene final : public Scene {
   RTCScene target_scene() const { return target_ < 0 ? scene_ : prototypes_[target_].scene; }
   std::vector<Geometry>& target_geometries() { return target_ < 0 ? geometries_ : prototypes_[target_].geometries; }
   Bounds3& target_bounds() { return target_ < 0 ? bounds_ : prototypes_[target_].bounds; }
-  void add_texture_footprint(SurfaceInteraction& si, const Geometry& g, Vec3 dpdu, Vec3 dpdv) const;
   void place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const;
+  void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;
+  const GeometryUserData* keep_user_data(GeometryUserData data);
+  static ShadingGeometry shading_geometry(const Geometry& g, const SurfaceInteraction& si, const Vec3& dpdu,
+                                          const Vec3& dpdv);
 
   std::vector<Prototype> prototypes_;
   std::vector<Instance> instances_;  // indexed by Embree geometry id in scene_
@@ -113,6 +129,7 @@ class EmbreeScene final : public Scene {
   std::vector<std::unique_ptr<Quadric>> quadrics_;
   std::vector<std::unique_ptr<Triangle>> light_shapes_;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
+  std::vector<std::unique_ptr<GeometryUserData>> user_data_;  // Embree callbacks' (quadrics, cut-outs)
   std::vector<const Light*> lights_, infinite_;
   Distribution1D light_distribution_;  // over lights_, proportional to luminance of power
   std::unique_ptr<Camera> camera_;

@@ -7,6 +7,7 @@
 #include "scene/orthographic_camera.h"
 #include "scene/perspective_camera.h"
 #include "scene/spherical_camera.h"
+#include "scene/surface_params.h"
 
 #include <penumbra/memory.h>
 
@@ -26,13 +27,13 @@ const ParamSpec kTriangleMeshParams[] = {
     {"point2[]", "uv", "", "per-vertex texture coordinates"},
     {"unsupported", "S", "", "tangents are not used"},
     {"unsupported", "faceIndices", "", ""},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 const ParamSpec kPlyMeshParams[] = {
     {"string", "filename", "", "PLY file (ASCII or binary; triangles and polygons)"},
-    {"unsupported", "displacement", "", "displacement is not supported"},
-    {"unsupported", "edgelength", "", "displacement is not supported"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"unsupported", "displacement", "", "displacement of PLY meshes is not supported (bump maps are: give the material \"texture displacement\")"},
+    {"unsupported", "edgelength", "", "displacement of PLY meshes is not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 const ParamSpec kGltfParams[] = {
     {"string", "filename", "", "glTF 2.0 file (.gltf or .glb): all triangle meshes of its default scene"},
@@ -42,7 +43,7 @@ const ParamSpec kSphereParams[] = {
     {"float", "zmin", "", "must cover the full sphere (partial spheres are not supported)"},
     {"float", "zmax", "", "must cover the full sphere (partial spheres are not supported)"},
     {"float", "phimax", "360", "must be 360 (partial spheres are not supported)"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 
 const ParamSpec kDiskParams[] = {
@@ -50,14 +51,14 @@ const ParamSpec kDiskParams[] = {
     {"float", "radius", "1", "outer radius"},
     {"float", "innerradius", "0", "inner radius (an annulus when > 0)"},
     {"float", "phimax", "360", "largest azimuth in degrees (a sector when < 360)"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 const ParamSpec kCylinderParams[] = {
     {"float", "radius", "1", "radius in object space"},
     {"float", "zmin", "-1", "lower end along z"},
     {"float", "zmax", "1", "upper end along z"},
     {"float", "phimax", "360", "largest azimuth in degrees"},
-    {"unsupported", "alpha", "", "alpha cut-outs are not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 
 std::string resolve(const std::string& base_dir, const std::string& file) {
@@ -140,6 +141,18 @@ std::unique_ptr<Sphere> load_sphere(ShapeEntity& e) {
       m[1][3] != 0.f || m[2][3] != 0.f)
     throw Error(e.loc, "a sphere under a non-uniform scale, shear or projection is not supported");
   return std::make_unique<Sphere>(m, r, e.reverse_orientation != swaps_handedness(m));
+}
+
+// pbrt-v4's anisotropic roughness parameters ("uroughness", "conductor.vroughness", Disney's
+// "anisotropic"): such materials need the shading frame oriented by dp/du.
+bool anisotropic(const ParamSet& params) {
+  auto ends_with = [](const std::string& s, const char* tail) {
+    size_t n = std::char_traits<char>::length(tail);
+    return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
+  };
+  for (const auto& p : params.params())
+    if (ends_with(p.name, "uroughness") || ends_with(p.name, "vroughness") || p.name == "anisotropic") return true;
+  return false;
 }
 
 bool uses_textures(const ParamSet& params) {
@@ -262,29 +275,64 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   // order; the default material only if some shape needs it.
   build_textures(desc, registry, out);
   std::vector<bool> material_textured;
+  std::vector<SurfaceDetail> material_detail;  // bump and normal maps, taken off the plugins' parameters
+  std::vector<bool> material_anisotropic;
   for (auto& m : desc.materials) {
     if (m.type.empty()) throw Error(m.loc, "material has no type");
     if (is_composite_material(m.type)) {  // "mix" and "interface": built below from the others
       out.bsdfs.push_back(nullptr);
       material_textured.push_back(true);  // its parts may be textured: give its hits a footprint
+      material_detail.emplace_back();
+      material_anisotropic.push_back(true);  // its parts may be
       continue;
     }
+    material_detail.push_back(take_surface_detail(m.params, m.base_dir, out.texture_table));
+    material_anisotropic.push_back(anisotropic(m.params));
     CreateContext ctx{m.params, {}, m.base_dir};
     ctx.textures = &out.texture_table;
     out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params, ctx, m.loc));
-    material_textured.push_back(uses_textures(m.params));
+    // A bump map evaluates its texture over the pixel footprint too.
+    material_textured.push_back(uses_textures(m.params) || material_detail.back().bump);
+  }
+  // A mix picks one of its materials per lookup, not per hit: their bump and normal maps cannot follow.
+  for (auto& m : desc.materials) {
+    const Param* names = m.type == "mix" ? m.params.find("materials") : nullptr;
+    if (!names) continue;
+    for (const std::string& name : names->strings)
+      if (auto it = desc.named_materials.find(name); it != desc.named_materials.end() && material_detail[it->second].any())
+        throw Error(names->loc, fmt::format("material '{}' has a bump or normal map: mixing it is not supported", name));
   }
   build_composite_materials(desc, out.bsdfs);
   const Bsdf* default_bsdf = nullptr;
   ParamSet default_params;
-  auto textured = [&](const ShapeEntity& s) {
+  auto material_index = [&](const ShapeEntity& s) {
     int i = s.material;
     if (i < 0 && !s.material_name.empty()) {
       auto it = desc.named_materials.find(s.material_name);
       i = it == desc.named_materials.end() ? -1 : it->second;
     }
+    return i;
+  };
+  auto textured = [&](const ShapeEntity& s) {
+    int i = material_index(s);
     return i >= 0 && material_textured[i];
   };
+  // The material's bump or normal map (unless a glTF primitive brings its own material) and the
+  // shape's alpha; a constant alpha of 0 drops the shape, as pbrt-v4 does.
+  auto surface_options = [&](const ShapeEntity& s, bool scene_material) {
+    SurfaceOptions o;
+    int i = material_index(s);
+    if (i >= 0 && scene_material) {
+      o.detail = material_detail[i];
+      o.tangent_frame = material_anisotropic[i];
+    }
+    o.cutout = shape_alpha(s.params, s.base_dir, out.texture_table);
+    if (o.cutout.active() && s.area_light >= 0)
+      throw Error(s.params.loc_of("alpha"), "alpha on a shape with an area light is not supported (its emission "
+                                            "would have to be cut out of light sampling too)");
+    return o;
+  };
+  auto invisible = [](const SurfaceOptions& o) { return o.cutout.alpha.is_constant() && o.cutout.alpha.constant() <= 0.f; };
   auto material_of = [&](const ShapeEntity& s) -> const Bsdf* {
     if (s.material >= 0) return out.bsdfs[s.material].get();
     if (!s.material_name.empty()) {
@@ -330,7 +378,9 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   MediaTable media(desc);
   std::vector<std::unique_ptr<Triangle>> light_triangles;
   auto add_mesh = [&](const ShapeEntity& s, std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
-                      bool is_textured) {
+                      bool is_textured, bool scene_material = true) {
+    SurfaceOptions options = surface_options(s, scene_material);
+    if (invisible(options)) return;
     std::vector<const Light*> lights;
     if (s.area_light >= 0) {
       float total_area = 0.f;
@@ -344,7 +394,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         lights.push_back(make_area_light(s, light_triangles.back().get(), total_area));
       }
     }
-    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s));
+    out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s), options);
   };
   auto add_shape = [&](ShapeEntity& s) {
     if (!material_of(s)) {  // "interface": no surface, rays pass
@@ -365,16 +415,20 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       for (GltfPrimitive& g : load_gltf(resolve(s.base_dir, file), loc)) {
         const Bsdf* bsdf = g.material ? gltf_bsdf(*g.material, s.loc) : material_of(s);
         add_mesh(s, make_mesh(s, std::move(g.P), std::move(g.indices), std::move(g.N), std::move(g.uv), loc, loc, loc), bsdf,
-                 !g.material && textured(s));
+                 !g.material && textured(s), !g.material);
       }
     } else if (s.type == "sphere") {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Sphere> sphere = load_sphere(s);
+      SurfaceOptions options = surface_options(s, true);
+      if (invisible(options)) return;
       const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get(), sphere->area()) : nullptr;
-      out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s), media.interface_of(s));
+      out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s), media.interface_of(s), options);
     } else if (s.type == "disk" || s.type == "cylinder") {
       const Bsdf* bsdf = material_of(s);
       std::unique_ptr<Quadric> quadric = load_quadric(s);
+      SurfaceOptions options = surface_options(s, true);
+      if (invisible(options)) return;
       const Light* light = nullptr;
       if (s.area_light >= 0) {
         if (!quadric->area_is_uniform())
@@ -382,7 +436,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
                              "supported (its emission could not be sampled uniformly by area)");
         light = make_area_light(s, quadric.get(), quadric->area());
       }
-      out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s));
+      out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s), options);
     } else {
       throw Error(s.loc, fmt::format("unsupported shape '{}'; available: cylinder, disk, gltf, plymesh, sphere, trianglemesh",
                                      s.type));

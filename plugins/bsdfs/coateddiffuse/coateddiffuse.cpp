@@ -63,8 +63,6 @@ const ParamSpec kParams[] = {
     {"float texture", "g", "0", "Henyey-Greenstein asymmetry of the medium"},
     {"integer", "maxdepth", "10", "most scattering events of a random walk through the layers"},
     {"integer", "nsamples", "1", "random walks averaged per f() and pdf() estimate"},
-    {"unsupported", "displacement", "", "displacement is not supported"},
-    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
 };
 
 Object* create(const CreateContext& ctx) {

@@ -62,8 +62,6 @@ const ParamSpec kParams[] = {
     {"float texture", "uroughness", "", "roughness along the shading frame's s axis (default: roughness)"},
     {"float texture", "vroughness", "", "roughness along the shading frame's t axis (default: roughness)"},
     {"bool", "remaproughness", "true", "alpha = sqrt(roughness) if true, else alpha = roughness"},
-    {"unsupported", "displacement", "", "displacement is not supported"},
-    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
 };
 
 Object* create(const CreateContext& ctx) {

@@ -33,8 +33,6 @@ class TexturedDiffuseBsdf final : public PerHitBsdf<TexturedDiffuseBsdf> {
 
 const ParamSpec kParams[] = {
     {"rgb texture", "reflectance", "0.5 0.5 0.5", "albedo, each channel in [0, 1], or a spectrum texture"},
-    {"unsupported", "displacement", "", "displacement is not supported"},
-    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
 };
 
 Object* create(const CreateContext& ctx) {

@@ -90,8 +90,6 @@ const ParamSpec kParams[] = {
     {"rgb texture", "reflectance", "0.25 0.25 0.25", "diffuse reflectance, each channel in [0, 1], or a spectrum texture"},
     {"rgb texture", "transmittance", "0.25 0.25 0.25", "diffuse transmittance, each channel in [0, 1], or a spectrum texture"},
     {"float", "scale", "1", "scales reflectance and transmittance"},
-    {"unsupported", "displacement", "", "displacement is not supported"},
-    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
 };
 
 Object* create(const CreateContext& ctx) {

@@ -65,8 +65,6 @@ const ParamSpec kParams[] = {
     {"float texture", "difftrans", "1", "thin only: 0 reflects all diffuse light, 2 transmits all"},
     {"unsupported", "scatterdistance", "", "subsurface scattering is not supported; use spectrans or thin"},
     {"unsupported", "bumpmap", "", "bump mapping is not supported"},
-    {"unsupported", "displacement", "", "displacement is not supported"},
-    {"unsupported", "normalmap", "", "normal maps are not supported yet"},
 };
 
 // The weights and blends are fractions: outside [0, max] they would create energy or go negative.
