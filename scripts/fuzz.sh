@@ -19,11 +19,17 @@ cxx="$(command -v clang++-14 || command -v clang++)"
 flags=(-std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
        -Icore/include -Icore/src -Itests -DPENUMBRA_SOURCE_DIR="\"$PWD\"")
 common=(core/src/util/error.cpp core/src/util/params.cpp core/src/util/input_file.cpp core/src/util/output_file.cpp)
+# The parser converts spectra as it reads (parser/spectrum_params.cpp): the spectrum code and the
+# tables CMake embeds from data/spectra, generated here the same way.
+mkdir -p build/fuzz
+cmake -DSPECTRA_DIR="$PWD/data/spectra" -DOUTPUT="$PWD/build/fuzz/spectrum_tables.cpp" -P cmake/EmbedSpectra.cmake
+spectra=(core/src/parser/spectrum_params.cpp core/src/spectra/named_spectra.cpp core/src/spectra/spd_file.cpp
+         core/src/spectra/spectrum.cpp build/fuzz/spectrum_tables.cpp)
 
 build_target() {
   case "$1" in
     parser) "$cxx" "${flags[@]}" core/src/parser/tokenizer.cpp core/src/parser/param_list.cpp core/src/parser/parser.cpp \
-              core/src/parser/entity_directives.cpp core/src/parser/transform_directives.cpp "${common[@]}" \
+              core/src/parser/entity_directives.cpp core/src/parser/transform_directives.cpp "${common[@]}" "${spectra[@]}" \
               tests/fuzz/parser_fuzzer.cpp -lfmt -o "$2" ;;
     ply) "$cxx" "${flags[@]}" core/src/parser/ply_reader.cpp "${common[@]}" tests/fuzz/ply_fuzzer.cpp -lfmt -o "$2" ;;
     gltf) "$cxx" "${flags[@]}" core/src/scene/gltf_loader.cpp "${common[@]}" tests/fuzz/gltf_fuzzer.cpp \
