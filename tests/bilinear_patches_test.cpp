@@ -141,6 +141,7 @@ TEST(BilinearPatches, PointsStayWithinTheStatedDeviation) {
   double dev = max_deviation(kTwisted, t.P, t.uv, t.indices);
   EXPECT_LE(dev, bound * 1.0001 + 1e-6) << dev << " " << bound;
   EXPECT_GT(dev, 0.1 * bound);  // the bound is not loose by orders of magnitude
+  RecordProperty("deviation", std::to_string(dev) + " of bound " + std::to_string(bound));
   // Negative control: the two-triangle version strays past that bound.
   std::vector<Vec2> uv = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
   EXPECT_GT(max_deviation(kTwisted, kTwisted, uv, {0, 1, 3, 0, 3, 2}), 10 * bound);
