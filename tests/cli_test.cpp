@@ -152,8 +152,8 @@ TEST(Cli, UndefinedNamedMaterialIsLocated) {
 TEST(Cli, UnsupportedShapeIsLocated) {
   auto r = render_text("curve", scene_with("", "Shape \"curve\"\n"));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: unsupported shape 'curve'; available: cylinder, disk, gltf, plymesh, "
-                               "sphere, trianglemesh"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: unsupported shape 'curve'; available: bilinearmesh, cylinder, disk, gltf, "
+                               "loopsubdiv, plymesh, sphere, trianglemesh"));
 }
 
 TEST(Cli, KnownButUnsupportedPbrtParameterSaysSo) {

@@ -2,6 +2,8 @@
 #include "scene/composite_materials.h"
 
 #include "parser/ply_reader.h"
+#include "scene/bilinear_patches.h"
+#include "scene/loop_subdivision.h"
 #include "scene/gltf_loader.h"
 #include "scene/media.h"
 #include "scene/orthographic_camera.h"
@@ -33,6 +35,21 @@ const ParamSpec kPlyMeshParams[] = {
     {"string", "filename", "", "PLY file (ASCII or binary; triangles and polygons)"},
     {"unsupported", "displacement", "", "displacement of PLY meshes is not supported (bump maps are: give the material \"texture displacement\")"},
     {"unsupported", "edgelength", "", "displacement of PLY meshes is not supported"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
+};
+const ParamSpec kLoopSubdivParams[] = {
+    {"integer", "levels", "3", "refinement steps before the vertices go to their limit positions"},
+    {"integer[]", "indices", "", "three vertex indices per triangle of the control mesh"},
+    {"point3[]", "P", "", "control mesh vertex positions"},
+    {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
+};
+const ParamSpec kBilinearMeshParams[] = {
+    {"point3[]", "P", "", "vertex positions"},
+    {"integer[]", "indices", "", "four vertex indices per patch: p00 p10 p01 p11 (optional for one patch)"},
+    {"point2[]", "uv", "", "per-vertex texture coordinates (default (0,0) (1,0) (0,1) (1,1) per patch)"},
+    {"normal[]", "N", "", "per-vertex shading normals"},
+    {"unsupported", "emissionfilename", "", "image-textured emission of bilinear patches is not supported"},
+    {"unsupported", "faceIndices", "", ""},
     {"float texture", "alpha", "1", "opacity in [0, 1] (0: cut out; fractions: stochastic), or a float texture"},
 };
 const ParamSpec kGltfParams[] = {
@@ -114,6 +131,21 @@ std::unique_ptr<TriangleMesh> load_mesh(ShapeEntity& e) {
     return make_mesh(e, e.params.get_point3s("P"), e.params.get_ints("indices"),
                      e.params.get_point3s("N"), e.params.get_point2s("uv"), e.params.loc_of("indices"),
                      e.params.loc_of("N"), e.params.loc_of("uv"));
+  }
+  if (e.type == "loopsubdiv") {
+    e.params.validate(kLoopSubdivParams, "shape 'loopsubdiv'");
+    FileLoc idx_loc = e.params.has("indices") ? e.params.loc_of("indices") : e.loc;
+    FileLoc levels_loc = e.params.has("levels") ? e.params.loc_of("levels") : e.loc;
+    LoopSurface s = loop_subdivide(e.params.get_point3s("P"), e.params.get_ints("indices"),
+                                   e.params.get_int("levels"), idx_loc, levels_loc);
+    return make_mesh(e, std::move(s.P), std::move(s.indices), std::move(s.N), {}, idx_loc, idx_loc, idx_loc);
+  }
+  if (e.type == "bilinearmesh") {
+    e.params.validate(kBilinearMeshParams, "shape 'bilinearmesh'");
+    TessellatedPatches t = tessellate_bilinear_patches(
+        e.params.get_point3s("P"), e.params.get_ints("indices"), e.params.get_point2s("uv"),
+        e.params.get_point3s("N"), e.loc, e.params.loc_of("indices"), e.params.loc_of("uv"), e.params.loc_of("N"));
+    return make_mesh(e, std::move(t.P), std::move(t.indices), std::move(t.N), std::move(t.uv), e.loc, e.loc, e.loc);
   }
   e.params.validate(kPlyMeshParams, "shape 'plymesh'");
   std::string file = e.params.get_string("filename");
@@ -404,7 +436,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
                            "dielectric material with eta 1 to bound the medium)");
       return;
     }
-    if (s.type == "trianglemesh" || s.type == "plymesh") {
+    if (s.type == "trianglemesh" || s.type == "plymesh" || s.type == "loopsubdiv" || s.type == "bilinearmesh") {
       const Bsdf* bsdf = material_of(s);
       add_mesh(s, load_mesh(s), bsdf, textured(s));
     } else if (s.type == "gltf") {
@@ -438,7 +470,8 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       }
       out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s), options);
     } else {
-      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: cylinder, disk, gltf, plymesh, sphere, trianglemesh",
+      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: bilinearmesh, cylinder, disk, gltf, loopsubdiv, plymesh, sphere, "
+                                     "trianglemesh",
                                      s.type));
     }
   };
