@@ -8,6 +8,7 @@
 #include "render/render_session.h"
 #include "scene/scene_builder.h"
 #include "support/command.h"
+#include "support/scene_errors.h"
 #include "support/image_stats.h"
 
 #include <fmt/core.h>
@@ -181,15 +182,7 @@ TEST(AbsorbingMedia, PathAndBdptAgreeInsideInk) {
 
 TEST(AbsorbingMedia, WhatIsNotSimulatedIsALocatedError) {
   Registry registry(Registry::default_search_dirs());
-  auto build_error = [&](const std::string& world) -> std::string {
-    SceneDescription d = parse_scene_string("WorldBegin\n" + world, "m.pbrt");
-    try {
-      build_scene(d, registry);
-    } catch (const Error& e) {
-      return e.formatted();
-    }
-    return "";
-  };
+  auto build_error = [](const std::string& world) { return scene_build_error(world, "m.pbrt"); };
   const std::string shape = "Shape \"sphere\"\n";
   // pbrt-v4's default sigma_s is 1: a medium that does not say 0 scatters.
   std::string e = build_error("MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\n" + shape);

@@ -4,6 +4,7 @@
 #include "parser/scene_description.h"
 #include "registry/registry.h"
 #include "scene/scene_builder.h"
+#include "support/scene_errors.h"
 
 #include <penumbra/bsdf.h>
 
@@ -19,14 +20,7 @@ BuiltScene build(const std::string& world) {
   return build_scene(d, registry);
 }
 
-std::string error_of(const std::string& world) {
-  try {
-    build(world);
-  } catch (const Error& e) {
-    return e.formatted();
-  }
-  return "";
-}
+std::string error_of(const std::string& world) { return test::scene_build_error(world, "a.pbrt"); }
 
 }  // namespace
 

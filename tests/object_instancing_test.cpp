@@ -7,6 +7,7 @@
 #include "render/render_session.h"
 #include "scene/scene_builder.h"
 #include "support/command.h"
+#include "support/scene_errors.h"
 #include "support/image_stats.h"
 
 #include <fmt/core.h>
@@ -103,16 +104,7 @@ TEST(ObjectInstancing, InstancesRenderAsTheCopiesWrittenOut) {
 }
 
 TEST(ObjectInstancing, MisuseIsALocatedError) {
-  auto error_of = [](const std::string& world) -> std::string {
-    Registry registry(Registry::default_search_dirs());
-    try {
-      SceneDescription d = parse_scene_string("WorldBegin\n" + world, "o.pbrt");
-      build_scene(d, registry);
-    } catch (const Error& e) {
-      return e.formatted();
-    }
-    return "";
-  };
+  auto error_of = [](const std::string& world) { return scene_build_error(world, "o.pbrt"); };
   auto expect_at = [&](const std::string& world, const std::string& where, const std::string& words) {
     std::string e = error_of(world);
     EXPECT_NE(e.find(where), std::string::npos) << e;

@@ -2,6 +2,7 @@
 #include "parser/scene_description.h"
 #include "registry/registry.h"
 #include "scene/scene_builder.h"
+#include "support/scene_errors.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -11,15 +12,10 @@ using ::testing::HasSubstr;
 
 namespace {
 
+// The scene's error, or "no error".
 std::string build_error(const std::string& world) {
-  Registry registry(Registry::default_search_dirs());
-  try {
-    SceneDescription d = parse_scene_string("WorldBegin\n" + world, "scene.pbrt");
-    build_scene(d, registry);
-  } catch (const Error& e) {
-    return e.formatted();
-  }
-  return "no error";
+  std::string e = test::scene_build_error(world);
+  return e.empty() ? "no error" : e;
 }
 
 const char* kQuad = "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  1 1 0 ]";

@@ -7,6 +7,7 @@
 #include "scene/perspective_camera.h"
 #include "scene/scene_builder.h"
 #include "support/command.h"
+#include "support/scene_errors.h"
 #include "support/image_stats.h"
 
 #include <penumbra/plugin.h>
@@ -23,15 +24,10 @@ using ::testing::HasSubstr;
 
 namespace {
 
+// The scene's error, or "no error".
 std::string build_error(const std::string& world) {
-  Registry registry(Registry::default_search_dirs());
-  try {
-    SceneDescription d = parse_scene_string("WorldBegin\n" + world, "scene.pbrt");
-    build_scene(d, registry);
-  } catch (const Error& e) {
-    return e.formatted();
-  }
-  return "no error";
+  std::string e = test::scene_build_error(world);
+  return e.empty() ? "no error" : e;
 }
 
 const char* kChecks = "Texture \"checks\" \"spectrum\" \"checkerboard\"\n";

@@ -33,6 +33,23 @@ static bool wants_tangent_frame(bool textured, const SurfaceOptions& o) {
   return textured || o.tangent_frame || o.detail.any();
 }
 
+// Commits an Embree geometry into the scene or the prototype being built, and records what its hits
+// need under the id Embree gave it.
+void EmbreeScene::attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
+                         const SurfaceOptions& options) {
+  rtcCommitGeometry(geom);
+  unsigned id = rtcAttachGeometry(target_scene(), geom);
+  rtcReleaseGeometry(geom);
+  g.bsdf = bsdf;
+  g.textured = textured;
+  g.media = media;
+  g.detail = options.detail;
+  g.tangent_frame = wants_tangent_frame(textured, options);
+  std::vector<Geometry>& geometries = target_geometries();
+  if (geometries.size() <= id) geometries.resize(id + 1);
+  geometries[id] = std::move(g);
+}
+
 const GeometryUserData* EmbreeScene::keep_user_data(GeometryUserData data) {
   user_data_.push_back(std::make_unique<GeometryUserData>(std::move(data)));
   return user_data_.back().get();
@@ -57,13 +74,10 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
                                                              mesh->triangle_count()));
   std::copy(mesh->indices.begin(), mesh->indices.end(), idx);
   if (options.cutout.active()) set_alpha_filters(geom, keep_user_data({mesh.get(), nullptr, nullptr, options.cutout}));
-  rtcCommitGeometry(geom);
-  unsigned id = rtcAttachGeometry(target_scene(), geom);
-  rtcReleaseGeometry(geom);
-  std::vector<Geometry>& geometries = target_geometries();
-  if (geometries.size() <= id) geometries.resize(id + 1);
-  geometries[id] = Geometry{mesh.get(), nullptr, nullptr, bsdf, std::move(lights), textured, media, options.detail,
-                            wants_tangent_frame(textured, options)};
+  Geometry g;
+  g.mesh = mesh.get();
+  g.lights = std::move(lights);
+  attach(geom, std::move(g), bsdf, textured, media, options);
   if (target_ >= 0) prototypes_[target_].triangles += mesh->triangle_count();
   meshes_.push_back(std::move(mesh));
 }
@@ -78,15 +92,10 @@ void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, c
   target_bounds().extend(c - Vec3(sphere->radius()));
   target_bounds().extend(c + Vec3(sphere->radius()));
   if (options.cutout.active()) set_alpha_filters(geom, keep_user_data({nullptr, sphere.get(), nullptr, options.cutout}));
-  rtcCommitGeometry(geom);
-  unsigned id = rtcAttachGeometry(target_scene(), geom);
-  rtcReleaseGeometry(geom);
-  std::vector<Geometry>& geometries = target_geometries();
-  if (geometries.size() <= id) geometries.resize(id + 1);
-  std::vector<const Light*> lights;
-  if (light) lights.push_back(light);
-  geometries[id] = Geometry{nullptr, sphere.get(), nullptr, bsdf, std::move(lights), textured, media, options.detail,
-                            wants_tangent_frame(textured, options)};
+  Geometry g;
+  g.sphere = sphere.get();
+  if (light) g.lights.push_back(light);
+  attach(geom, std::move(g), bsdf, textured, media, options);
   spheres_.push_back(std::move(sphere));
 }
 
@@ -144,22 +153,10 @@ void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf
   Bounds3 b = quadric->world_bounds();
   target_bounds().extend(b.min);
   target_bounds().extend(b.max);
-  rtcCommitGeometry(geom);
-  unsigned id = rtcAttachGeometry(target_scene(), geom);
-  rtcReleaseGeometry(geom);
-  std::vector<Geometry>& geometries = target_geometries();
-  if (geometries.size() <= id) geometries.resize(id + 1);
-  std::vector<const Light*> lights;
-  if (light) lights.push_back(light);
   Geometry g;
   g.quadric = quadric.get();
-  g.bsdf = bsdf;
-  g.lights = std::move(lights);
-  g.textured = textured;
-  g.media = media;
-  g.detail = options.detail;
-  g.tangent_frame = wants_tangent_frame(textured, options);
-  geometries[id] = std::move(g);
+  if (light) g.lights.push_back(light);
+  attach(geom, std::move(g), bsdf, textured, media, options);
   quadrics_.push_back(std::move(quadric));
 }
 

@@ -111,6 +111,8 @@ class EmbreeScene final : public Scene {
   std::vector<Geometry>& target_geometries() { return target_ < 0 ? geometries_ : prototypes_[target_].geometries; }
   Bounds3& target_bounds() { return target_ < 0 ? bounds_ : prototypes_[target_].bounds; }
   void place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const;
+  void attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
+              const SurfaceOptions& options);
   void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;
   const GeometryUserData* keep_user_data(GeometryUserData data);
   static ShadingGeometry shading_geometry(const Geometry& g, const SurfaceInteraction& si, const Vec3& dpdu,
