@@ -24,11 +24,6 @@ using ::testing::HasSubstr;
 
 namespace {
 
-// The scene's error, or "no error".
-std::string build_error(const std::string& world) {
-  std::string e = test::scene_build_error(world);
-  return e.empty() ? "no error" : e;
-}
 
 const char* kChecks = "Texture \"checks\" \"spectrum\" \"checkerboard\"\n";
 const char* kRough = "Texture \"rough\" \"float\" \"constant\" \"float value\" [ 0.2 ]\n";
@@ -36,36 +31,36 @@ const char* kRough = "Texture \"rough\" \"float\" \"constant\" \"float value\" [
 }  // namespace
 
 TEST(TextureScene, UndefinedTextureIsALocatedError) {
-  EXPECT_THAT(build_error("Material \"diffuse\" \"texture reflectance\" \"checkz\"\n"),
+  EXPECT_THAT(test::scene_build_error("Material \"diffuse\" \"texture reflectance\" \"checkz\"\n"),
               HasSubstr("scene.pbrt:2:20: error: spectrum texture 'checkz' is not defined"));
 }
 
 TEST(TextureScene, FloatTextureWhereASpectrumIsNeeded) {
-  EXPECT_THAT(build_error(std::string(kRough) + "Material \"diffuse\" \"texture reflectance\" \"rough\"\n"),
+  EXPECT_THAT(test::scene_build_error(std::string(kRough) + "Material \"diffuse\" \"texture reflectance\" \"rough\"\n"),
               HasSubstr("scene.pbrt:3:20: error: parameter 'reflectance' needs a spectrum texture, but 'rough' "
                         "is a float texture (defined at scene.pbrt:2:1)"));
 }
 
 TEST(TextureScene, SpectrumTextureWhereAFloatIsNeeded) {
-  EXPECT_THAT(build_error(std::string(kChecks) + "Material \"conductor\" \"texture roughness\" \"checks\"\n"),
+  EXPECT_THAT(test::scene_build_error(std::string(kChecks) + "Material \"conductor\" \"texture roughness\" \"checks\"\n"),
               HasSubstr("scene.pbrt:3:22: error: parameter 'roughness' needs a float texture, but 'checks' is a "
                         "spectrum texture"));
 }
 
 TEST(TextureScene, TextureUsedBeforeItsDefinition) {
-  EXPECT_THAT(build_error("Texture \"a\" \"float\" \"scale\" \"texture tex\" \"b\"\n"
+  EXPECT_THAT(test::scene_build_error("Texture \"a\" \"float\" \"scale\" \"texture tex\" \"b\"\n"
                           "Texture \"b\" \"float\" \"constant\"\n"),
               HasSubstr("scene.pbrt:2:29: error: float texture 'b' is defined later (at scene.pbrt:3:1)"));
 }
 
 TEST(TextureScene, UnknownTextureClassListsTheKnownOnes) {
-  EXPECT_THAT(build_error("Texture \"w\" \"float\" \"wrinkled\"\n"),
+  EXPECT_THAT(test::scene_build_error("Texture \"w\" \"float\" \"wrinkled\"\n"),
               HasSubstr("scene.pbrt:2:1: error: unknown texture 'wrinkled'; available: bilerp, checkerboard, "
                         "constant, directionmix, imagemap, mix, scale"));
 }
 
 TEST(TextureScene, TextureWhereNoTextureIsAllowed) {
-  EXPECT_THAT(build_error(std::string(kRough) + "Material \"dielectric\" \"texture eta\" \"rough\"\n"),
+  EXPECT_THAT(test::scene_build_error(std::string(kRough) + "Material \"dielectric\" \"texture eta\" \"rough\"\n"),
               HasSubstr("scene.pbrt:3:23: error: parameter 'eta' of bsdf 'dielectric' must have type 'float' or 'spectrum', not 'texture'"));
 }
 

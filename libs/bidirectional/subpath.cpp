@@ -92,6 +92,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
   if (max_vertices <= 0) return 0;
   const Scene& scene = ctx.scene;
   float roulette_scale = std::max(max_component(beta), 1e-30f);
+  const bool media = scene.has_media();
   int added = 0;
   for (;;) {
     Vertex& prev = path[added];
@@ -99,7 +100,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     Vertex* before = added > 0 ? &path[added - 1] : nullptr;
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
     int medium = kMediumUnknown;
-    if (scene.has_media()) {  // absorption along the segment just traced
+    if (media) {  // absorption along the segment just traced
       medium = segment_medium(medium_side(prev, ray.d), si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
       beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
     }

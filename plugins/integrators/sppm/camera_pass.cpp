@@ -120,9 +120,10 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
   Rgb beta(1.f);
   bool specular_bounce = false;
   int medium = kMediumUnknown;  // the medium `ray` travels in, where known (absorbing media)
+  const bool media = scene.has_media();
   for (int depth = 0;; ++depth) {
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
-    if (scene.has_media()) {
+    if (media) {
       medium = segment_medium(medium, si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
       beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
     }

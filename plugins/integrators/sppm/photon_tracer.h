@@ -41,10 +41,11 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& depos
   Ray ray = le->ray;
   ray.d = glm::normalize(ray.d);
   int medium = kMediumUnknown;  // the medium `ray` travels in, where known (absorbing media)
+  const bool media = scene.has_media();
   for (int depth = 0; depth < max_depth; ++depth) {
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
     if (!si) return;
-    if (scene.has_media()) {  // absorption along the segment: the photon's flux weight falls
+    if (media) {  // absorption along the segment: the photon's flux weight falls
       medium = segment_medium(medium, si->media.toward(si->ng, -ray.d));
       beta *= scene.transmittance(medium, si->t);
       if (is_black(beta)) return;
