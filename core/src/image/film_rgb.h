@@ -25,9 +25,16 @@ class PixelFilter {
   FilterSample sample(Vec2 u) const;
   Vec2 radius() const { return radius_; }
   const std::string& type() const { return type_; }
+  /// The filter normalised to integral 1 along one axis, at offset x from a pixel centre: the share
+  /// of a splat at that offset the pixel receives, so that splats are filtered as camera samples are.
+  float normalized(float x, int axis) const;
+  /// A box of radius 0.5: every point belongs to exactly one pixel, with weight 1.
+  bool single_pixel() const { return type_ == "box" && radius_.x == 0.5f && radius_.y == 0.5f; }
 
  private:
   float sample_axis(float u, int axis, float* weight) const;
+  float evaluate_axis(float x, int axis) const;
+  Vec2 integral_{1.f};  // per axis, the integral of evaluate_axis over [-radius, radius]
   float eval_gaussian(float x, float r) const;
   std::string type_;
   Vec2 radius_;

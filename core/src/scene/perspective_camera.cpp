@@ -19,8 +19,8 @@ static const ParamSpec kParams[] = {
 std::span<const ParamSpec> perspective_camera_params() { return kParams; }
 
 PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_to_world,
-                                     Point2i resolution)
-    : to_world_(camera_to_world), resolution_(resolution) {
+                                     Point2i resolution, Vec2 filter_radius)
+    : to_world_(camera_to_world), resolution_(resolution), margin_(glm::max(filter_radius - 0.5f, Vec2(0.f))) {
   ScreenWindow w = screen_window(params, resolution);
   screen_min_ = w.min;
   screen_max_ = w.max;
@@ -40,6 +40,10 @@ PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_
   film_area_ = std::abs(extent.x * extent.y);
   lens_area_ = lens_radius_ > 0.f ? Pi * lens_radius_ * lens_radius_ : 1.f;
   pixel_spread_ = Vec2(std::abs(extent.x) / resolution.x, std::abs(extent.y) / resolution.y);
+  plane_ = lens_radius_ > 0.f ? focal_distance_ : 1.f;
+  screen_of_plane_ = 1.f / (plane_ * tan_half_fov_);
+  raster_per_screen_ = Vec2(resolution_.x / (screen_max_.x - screen_min_.x), resolution_.y / (screen_max_.y - screen_min_.y));
+  axis_ = glm::normalize(Vec3(to_world_ * Vec4(0.f, 0.f, 1.f, 0.f)));
 }
 
 // pbrt-v4's estimate: rotate camera space so that p lies on +z, offset the central ray's direction
@@ -96,13 +100,11 @@ bool PerspectiveCamera::raster_of(const Vec3& o, const Vec3& d, Vec2* p_raster, 
   if (!(d.z > 0.f)) return false;
   // A thin lens maps the ray to where it crosses the plane in focus; every ray of a film point
   // passes through the same point there. A pinhole's rays all start at the origin.
-  float plane = lens_radius_ > 0.f ? focal_distance_ : 1.f;
-  Vec3 p = o + d * ((plane - o.z) / d.z);
-  Vec2 screen = Vec2(p.x, p.y) / (plane * tan_half_fov_);
-  Vec2 r((screen.x - screen_min_.x) / (screen_max_.x - screen_min_.x) * resolution_.x,
-         (screen_max_.y - screen.y) / (screen_max_.y - screen_min_.y) * resolution_.y);
+  Vec3 p = o + d * ((plane_ - o.z) / d.z);
+  Vec2 screen = Vec2(p.x, p.y) * screen_of_plane_;
+  Vec2 r((screen.x - screen_min_.x) * raster_per_screen_.x, (screen_max_.y - screen.y) * raster_per_screen_.y);
   if (p_raster) *p_raster = r;
-  return r.x >= 0.f && r.y >= 0.f && r.x < resolution_.x && r.y < resolution_.y;
+  return r.x >= -margin_.x && r.y >= -margin_.y && r.x < resolution_.x + margin_.x && r.y < resolution_.y + margin_.y;
 }
 
 Rgb PerspectiveCamera::We(const Ray& ray, Vec2* p_raster) const {
@@ -137,8 +139,7 @@ std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Ve
   float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.f)) return std::nullopt;
   s.wi = d / std::sqrt(dist2);
-  Vec3 axis = glm::normalize(Vec3(to_world_ * Vec4(0.f, 0.f, 1.f, 0.f)));
-  float cos_lens = std::abs(glm::dot(axis, s.wi));
+  float cos_lens = std::abs(glm::dot(axis_, s.wi));
   if (cos_lens == 0.f) return std::nullopt;
   s.We = We(Ray{s.p_lens, -s.wi, Infinity}, &s.p_raster);
   if (is_black(s.We)) return std::nullopt;

@@ -13,8 +13,12 @@ namespace penumbra {
 
 class PerspectiveCamera final : public Camera {
  public:
-  /// Parameters: see kPerspectiveCameraParams.
-  PerspectiveCamera(const ParamSet& params, const Mat4& camera_to_world, Point2i resolution);
+  /// Parameters: see kPerspectiveCameraParams. `filter_radius`: the film's pixel filter radius, in
+  /// pixels. Camera rays leave the film rectangle by up to radius - 1/2 (the filter's samples around
+  /// the border pixels), so importance (We, pdf_we, sample_wi) extends as far: a light path reaching
+  /// the camera there splats onto the border pixels as their camera samples there count for them.
+  PerspectiveCamera(const ParamSet& params, const Mat4& camera_to_world, Point2i resolution,
+                    Vec2 filter_radius = Vec2(0.5f));
   Point2i resolution() const override { return resolution_; }
   std::optional<Ray> generate_ray(const CameraSample& s) const override;
   Rgb We(const Ray& ray, Vec2* p_raster = nullptr) const override;
@@ -25,7 +29,7 @@ class PerspectiveCamera final : public Camera {
 
  private:
   /// Raster position of the camera-space ray (o, unit d), through the plane in focus; false when it
-  /// misses the film. `cos_theta` receives d.z.
+  /// misses the film and its filter margin. `cos_theta` receives d.z.
   bool raster_of(const Vec3& o, const Vec3& d, Vec2* p_raster, float* cos_theta) const;
 
   Mat4 to_world_, from_world_;
@@ -36,6 +40,12 @@ class PerspectiveCamera final : public Camera {
   float film_area_ = 1.f;  // area of the film's image on the z = 1 plane of camera space
   float lens_area_ = 1.f;  // 1 for a pinhole, so that its position density is a unit delta
   Vec2 pixel_spread_{0.f};  // camera-space size of one pixel on the z = 1 plane (x and y)
+  // Constants of raster_of() and sample_wi(), which light tracing calls for every light vertex.
+  float plane_ = 1.f;               // the plane raster_of() intersects: z = 1, or the plane in focus
+  float screen_of_plane_ = 1.f;     // 1 / (plane_ tan(fov / 2)): plane coordinates to screen units
+  Vec2 raster_per_screen_{0.f};     // raster pixels per screen unit, x and y
+  Vec3 axis_{0.f, 0.f, 1.f};        // the viewing direction in world space
+  Vec2 margin_{0.f};                // filter radius - 1/2: how far (pixels) importance reaches beyond the film
 };
 
 std::span<const ParamSpec> perspective_camera_params();

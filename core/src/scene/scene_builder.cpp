@@ -276,12 +276,14 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     throw Error(desc.filter.loc,
                 fmt::format("unsupported pixel filter '{}'; available: box, gaussian, triangle", filter_type));
   desc.filter.params.validate(pixel_filter_params(filter_type), fmt::format("filter '{}'", filter_type));
-  out.film = std::make_unique<FilmRgb>(res, PixelFilter(filter_type, desc.filter.params, desc.filter.loc), aov_set);
+  PixelFilter filter(filter_type, desc.filter.params, desc.filter.loc);
+  const Vec2 filter_radius = filter.radius();
+  out.film = std::make_unique<FilmRgb>(res, std::move(filter), aov_set);
 
   std::unique_ptr<Camera> camera;
   if (desc.camera.type.empty() || desc.camera.type == "perspective") {
     desc.camera.params.validate(perspective_camera_params(), "camera 'perspective'");
-    camera = std::make_unique<PerspectiveCamera>(desc.camera.params, desc.camera.to_world, res);
+    camera = std::make_unique<PerspectiveCamera>(desc.camera.params, desc.camera.to_world, res, filter_radius);
   } else if (desc.camera.type == "orthographic") {
     desc.camera.params.validate(orthographic_camera_params(), "camera 'orthographic'");
     camera = std::make_unique<OrthographicCamera>(desc.camera.params, desc.camera.to_world, res);
