@@ -55,6 +55,7 @@ Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMo
   v.tex = si.texture_context();
   v.wo = si.wo;
   v.bsdf = si.bsdf;
+  v.surface_connectible = si.bsdf && si.bsdf->flags() != 0 && !si.bsdf->is_specular_only();
   v.light = si.area_light;
   v.beta = beta;
   v.mode = mode;
@@ -184,7 +185,7 @@ bool Vertex::connectible() const {
   switch (kind) {
     case VertexKind::Camera: return true;
     case VertexKind::Light: return !infinite;  // a direction cannot be connected to deterministically
-    case VertexKind::Surface: return bsdf && bsdf->flags() != 0 && !bsdf->is_specular_only();
+    case VertexKind::Surface: return surface_connectible;
   }
   return false;
 }
@@ -551,6 +552,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     ps.seek(PathSampler::lens(s - 1));
     std::optional<CameraWiSample> cw = scene.camera().sample_wi(qs.p, ps.get_2d());
     if (!cw || !(cw->pdf > 0.f)) return c;
+    c.sampled = Vertex{};
     Vertex& cam = c.sampled;
     cam.kind = VertexKind::Camera;
     cam.p = cw->p_lens;
@@ -596,6 +598,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     if (!sl || !(sl->pmf > 0.f)) return c;
     std::optional<LightLiSample> ls = sl->light->sample_li(LightSampleContext{pt.p, pt.ng}, u);
     if (!ls || !(ls->pdf > 0.f) || is_black(ls->L)) return c;
+    c.sampled = Vertex{};
     Vertex& lv = c.sampled;
     lv.kind = VertexKind::Light;
     lv.light = sl->light;

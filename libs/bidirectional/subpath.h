@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 namespace penumbra::bdpt {
@@ -53,6 +54,9 @@ enum class VertexKind : uint8_t { Camera, Light, Surface };
 
 struct Vertex {
   VertexKind kind = VertexKind::Surface;
+  // Surfaces: the BSDF has a non-delta lobe (connectible(); set once when the vertex is made, since
+  // every connection asks, through two virtual calls into the BSDF's plugin). Fits in kind's padding.
+  bool surface_connectible = false;
   Vec3 p{0.f};
   Vec3 p_error{0.f};      // bound on the floating-point error of p (surfaces), for ray offsets
   Vec3 ng{0.f}, ns{0.f};  // zero for points not on a surface (point lights, the lens)
@@ -188,14 +192,22 @@ int camera_subpath(const Context& ctx, const Ray& ray, PathSampler& ps, Vertex* 
 /// Traces a light subpath into path[0 .. max_depth]; returns the vertex count (0: no light).
 int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path);
 
+static_assert(std::is_trivially_copyable_v<Vertex> && std::is_trivially_destructible_v<Vertex>);
+
 struct Connection {
   Rgb L{0.f};          // unweighted contribution
   Rgb weighted{0.f};   // MIS-weighted contribution (what the image receives)
   double weight = 0.0; // MIS weight (for several environment lights: the last one's)
   bool splat = false;  // t = 1: lands at p_raster instead of the pixel being sampled
   Vec2 p_raster{0.f};
-  Vertex sampled;      // the endpoint drawn for s = 1 (light) or t = 1 (camera)
   bool has_sampled = false;
+  // The endpoint drawn for s = 1 (light) or t = 1 (camera), valid only when has_sampled. Left
+  // uninitialised otherwise: connect() runs about ten times per sample and most calls draw none,
+  // and zeroing a 168-byte vertex each time was a visible part of its cost.
+  union {
+    Vertex sampled;
+  };
+  Connection() {}
 };
 
 /// Evaluates strategy (s, t) on the given subpaths. weighted = false skips MIS (weight 1), for pure

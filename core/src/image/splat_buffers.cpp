@@ -29,8 +29,9 @@ uint64_t SplatBuffers::worst_case_bytes(Point2i resolution, int threads) {
 // The calling thread's buffer: TBB's lookup by thread id once, then a thread-local cache (a splat
 // costs a comparison instead of a hash lookup).
 SplatBuffers::ThreadBuffer& SplatBuffers::local() {
-  thread_local uint64_t cached_id = 0;
-  thread_local ThreadBuffer* cached = nullptr;
+  // Initial-exec TLS, as the ray counter's (render/ray_counter.h).
+  thread_local uint64_t cached_id __attribute__((tls_model("initial-exec"))) = 0;
+  thread_local ThreadBuffer* cached __attribute__((tls_model("initial-exec"))) = nullptr;
   if (cached_id != id_) {
     cached = &threads_.local();
     cached_id = id_;
@@ -65,11 +66,30 @@ bool SplatBuffers::add(int x, int y, const Rgb& v) {
     any_.store(true, std::memory_order_relaxed);
   }
   Fixed* p = &b->v[3 * ((y % kBlock) * kBlock + x % kBlock)];
-  for (int c = 0; c < 3; ++c) p[c] += q[c];
+  // The pixel's 48 bytes span at most two cache lines.
+  __builtin_prefetch(p, 1);
+  __builtin_prefetch(reinterpret_cast<const char*>(p) + sizeof(Fixed) * 3 - 1, 1);
+  Pending& slot = tb.pending[tb.pending_next];
+  if (tb.pending_count == kPending)
+    apply(slot);
+  else
+    ++tb.pending_count;
+  slot.p = p;
+  for (int c = 0; c < 3; ++c) slot.q[c] = q[c];
+  tb.pending_next = (tb.pending_next + 1) % kPending;
   return true;
 }
 
+void SplatBuffers::flush(ThreadBuffer& tb) {
+  // The queue holds the last pending_count splats, ending just before pending_next.
+  for (int i = 0; i < tb.pending_count; ++i) apply(tb.pending[(tb.pending_next + kPending - 1 - i) % kPending]);
+  tb.pending_count = 0;
+  tb.pending_next = 0;
+}
+
 std::vector<SplatBuffers::Fixed> SplatBuffers::fixed_totals() const {
+  // Called between passes, when no thread adds: the queued splats of every thread go in first.
+  for (ThreadBuffer& tb : threads_) flush(tb);
   const size_t n = 3 * static_cast<size_t>(resolution_.x) * resolution_.y;
   std::vector<Fixed> out = base_.empty() ? std::vector<Fixed>(n, Fixed(0)) : base_;
   for (int by = 0; by < blocks_y_; ++by)

@@ -9,7 +9,9 @@ void count_rays_slow_path();
 struct ThreadRayCount {
   uint64_t rays = 0;
 };
-extern thread_local ThreadRayCount* t_ray_count;
+// Initial-exec TLS: libpenumbra-core is loaded with the program (never dlopen'ed), so the counter
+// is one fs-relative load instead of a __tls_get_addr call per ray.
+extern thread_local ThreadRayCount* t_ray_count __attribute__((tls_model("initial-exec")));
 
 inline void count_ray() {
   if (!t_ray_count) count_rays_slow_path();
