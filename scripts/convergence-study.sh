@@ -4,12 +4,14 @@
 # scripts/plot-convergence.py draws relMSE versus time and scripts/write-convergence-doc.py writes
 # the tables. Settings (environment variables): TIME seconds per run, RUNS runs per configuration,
 # REF seconds for the reference, RES resolution, SNAPSHOTS per run, SCENES to limit the scenes.
-# The defaults take about an hour on 2 cores; TIME=6 RUNS=2 REF=40 gives a quick look.
+# An empty reference configuration leaves the choice to `penumbra converge` (an unbiased integrator
+# not compared, else one half each of two). The defaults take about 50 minutes on 2 cores and must
+# run on a quiet machine (the figures are times); TIME=4 RUNS=3 REF=30 gives a quick look.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-TIME=${TIME:-20}
-RUNS=${RUNS:-3}
-REF=${REF:-240}
+TIME=${TIME:-10}
+RUNS=${RUNS:-8}
+REF=${REF:-180}
 RES=${RES:-128x96}
 SNAPSHOTS=${SNAPSHOTS:-7}
 scripts/build.sh >&2
@@ -19,13 +21,18 @@ has() { grep -q "$1 '$2'" <<<"$plugins"; }
 
 # name | scene file | configurations (only those whose plugins exist are run) | reference configuration
 studies=(
-  "cornell-box|scenes/cornell-box/scene.pbrt|path:independent path:sobol path:halton bdpt:sobol sppm:halton|path:sobol"
-  "environment|scenes/environment/scene.pbrt|path:independent path:sobol bdpt:sobol sppm:halton|path:sobol"
-  "caustics|scenes/caustics/scene.pbrt|path:sobol bdpt:sobol bdpt/hrr=true:sobol sppm:halton|bdpt:sobol"
+  "cornell-box|scenes/cornell-box/scene.pbrt|path:independent path:sobol path:halton bdpt:sobol sppm:halton|"
+  "environment|scenes/environment/scene.pbrt|path:independent path:sobol bdpt:sobol sppm:halton|"
+  "caustics|scenes/caustics/scene.pbrt|path:sobol bdpt:sobol bdpt/hrr=true:sobol sppm:halton|"
   "sppm-caustics|scenes/sppm-caustics/scene.pbrt|path:sobol bdpt:sobol sppm:halton|sppm:halton"
+  "window|scenes/window/scene.pbrt|path:sobol bdpt:sobol bdpt/hrr=true:sobol bdpt/probconnect=true:sobol bdpt/hrr=true/probconnect=true:sobol|"
 )
 out=docs/convergence
 mkdir -p "$out"
+# Fresh references for every study run: the converge cache is keyed by scene and settings, not by the
+# renderer build, and a published study must not reuse a reference an older build made.
+refcache=$(mktemp -d "${TMPDIR:-/tmp}/penumbra-study-references.XXXXXX")
+trap 'rm -rf "$refcache"' EXIT
 for study in "${studies[@]}"; do
   IFS='|' read -r name scene configs refconfig <<<"$study"
   if [ -n "${SCENES:-}" ] && ! grep -qw "$name" <<<"$SCENES"; then continue; fi
@@ -33,10 +40,14 @@ for study in "${studies[@]}"; do
   list=()
   # A configuration may set integrator parameters: integrator[/NAME=VALUE...][:sampler].
   for c in $configs; do has integrator "${c%%[:/]*}" && list+=("$c"); done
-  has integrator "${refconfig%%[:/]*}" || refconfig="path:sobol"
+  refargs=()
+  if [ -n "$refconfig" ]; then
+    has integrator "${refconfig%%[:/]*}" || refconfig="path:sobol"
+    refargs=(--reference-config "$refconfig")
+  fi
   joined=$(IFS=,; echo "${list[*]}")
-  echo "== $name: $joined (reference $refconfig, ${REF}s)" >&2
-  $bin converge "$scene" --configs "$joined" --make-reference "$REF" --reference-config "$refconfig" \
+  echo "== $name: $joined (reference ${refconfig:-the converge default}, ${REF}s)" >&2
+  PENUMBRA_REFERENCE_CACHE="$refcache" $bin converge "$scene" --configs "$joined" --make-reference "$REF" "${refargs[@]}" \
     --time "$TIME" --runs "$RUNS" --snapshots "$SNAPSHOTS" --res "$RES" -o "$out/$name"
   /usr/bin/python3 scripts/plot-convergence.py "$out/$name" "$name"
   rm -f "$out/$name"/reference*.exr

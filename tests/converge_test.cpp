@@ -6,6 +6,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
 using namespace penumbra;
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -108,4 +114,42 @@ TEST(Converge, DefaultReferenceIsAnotherIntegratorAndIsCached) {
   ASSERT_EQ(second.exit_code, 0) << second.err;
   EXPECT_THAT(second.err, HasSubstr("reference from the cache"));
   EXPECT_THAT(second.err, Not(HasSubstr("reference half 1")));
+}
+
+// A run whose first pass outlasts the first snapshot times (here the probabilistic-connection pilot)
+// skips those snapshots. Each snapshot must be filed under the latest snapshot time it has passed,
+// so that ratios at equal time compare images of the same time: before, snapshots were numbered in
+// sequence, and such a run's 10-s image was compared with the other runs' 5-s images.
+TEST(Converge, SnapshotsAreFiledUnderTheTimeTheyStandFor) {
+  std::string dir = test::temp_dir("converge-slots");
+  const double budget = 0.8;
+  const int snapshots = 8;
+  auto r = test::run_penumbra({"converge", std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt",
+                               "--configs", "path:independent,bdpt/probconnect=true:sobol", "--make-reference", "1",
+                               "--time", "0.8", "--runs", "2", "--snapshots", std::to_string(snapshots), "--res",
+                               "32x32", "--threads", "2", "-o", dir},
+                              "PENUMBRA_REFERENCE_CACHE=" + dir + "/cache");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream csv(test::read_file(dir + "/results.csv"));
+  std::string line;
+  std::getline(csv, line);  // header
+  int rows = 0, skipped_first = 0;
+  std::map<std::string, int> previous;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
+    ASSERT_GE(f.size(), 4u) << line;
+    int slot = std::stoi(f[2]);
+    double seconds = std::stod(f[3]);
+    auto time_of = [&](int k) { return budget * std::pow(2.0, -(snapshots - 1 - k)); };
+    EXPECT_GE(seconds, time_of(slot) * (1 - 1e-6)) << line;
+    if (slot + 1 < snapshots) EXPECT_LT(seconds, time_of(slot + 1)) << line;
+    std::string run = f[0] + "#" + f[1];
+    if (!previous.count(run) && slot > 0) ++skipped_first;
+    previous[run] = slot;
+    ++rows;
+  }
+  EXPECT_GT(rows, 0);
+  std::printf("  %d rows, %d runs whose first snapshot is not the first time\n", rows, skipped_first);
 }

@@ -272,7 +272,14 @@ int run_converge(const ConvergeSettings& s) {
       if (run == 0) report_images.configs.emplace_back(config.name, ImageRgb{});
       r.on_snapshot = [&](double seconds, int spp, const ImageRgb& img) {
         ImageErrors e = image_errors(img, reference, have_variance ? &variance : nullptr);
-        rows.push_back(Row{config.name, run, snapshot++, seconds, spp, e});
+        // The snapshot stands for the latest snapshot time it has passed, not for the next in
+        // sequence: a run whose first pass outlasts the first snapshot times (a pilot, a long
+        // iteration) skips those, and numbering its snapshots in order compared its 10-s image with
+        // the others' 5-s images.
+        int slot = snapshot;
+        while (slot + 1 < static_cast<int>(times.size()) && times[slot + 1] <= seconds * (1.0 + 1e-9)) ++slot;
+        rows.push_back(Row{config.name, run, slot, seconds, spp, e});
+        snapshot = slot + 1;
         if (run == 0) report_images.configs.back().second = img;  // the first run's latest snapshot
       };
       std::fprintf(stderr, "converge: %s run %d/%d (%.0f s)\n", config.name.c_str(), run + 1, s.runs, s.time);
