@@ -51,7 +51,7 @@ std::span<const ParamSpec> pixel_filter_params(const std::string& type) {
 }
 
 PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const FileLoc& loc)
-    : type_(type) {
+    : type_(type), shape_(type == "box" ? Shape::Box : type == "triangle" ? Shape::Triangle : Shape::Gaussian) {
   if (pixel_filter_params(type).empty())
     throw Error(loc, fmt::format("unsupported pixel filter '{}'; available: box, gaussian, triangle", type));
   radius_ = Vec2(params.get_float("xradius"), params.get_float("yradius"));
@@ -92,8 +92,8 @@ PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const 
 float PixelFilter::evaluate_axis(float x, int axis) const {
   const float r = radius_[axis];
   if (!(std::abs(x) < r)) return 0.f;
-  if (type_ == "box") return 1.f;
-  if (type_ == "triangle") return r - std::abs(x);
+  if (shape_ == Shape::Box) return 1.f;
+  if (shape_ == Shape::Triangle) return r - std::abs(x);
   return eval_gaussian(x, r);
 }
 
@@ -108,11 +108,11 @@ float PixelFilter::eval_gaussian(float x, float r) const {
 // cancels in the weighted pixel mean.
 float PixelFilter::sample_axis(float u, int axis, float* weight) const {
   float r = radius_[axis];
-  if (type_ == "box") {
+  if (shape_ == Shape::Box) {
     *weight = 1.f;
     return (2.f * u - 1.f) * r;
   }
-  if (type_ == "triangle") {
+  if (shape_ == Shape::Triangle) {
     *weight = 1.f;
     return u < 0.5f ? -r + r * std::sqrt(2.f * u) : r - r * std::sqrt(2.f - 2.f * u);
   }
@@ -183,11 +183,14 @@ void FilmRgb::add_splat(const Vec2& p_raster, const Rgb& v) {
   const int x1 = std::min(resolution_.x - 1, static_cast<int>(std::ceil(p_raster.x - 0.5f + r.x)) - 1);
   const int y0 = std::max(0, static_cast<int>(std::floor(p_raster.y - 0.5f - r.y)) + 1);
   const int y1 = std::min(resolution_.y - 1, static_cast<int>(std::ceil(p_raster.y - 0.5f + r.y)) - 1);
+  // The filter is separable: the x weights once, then one row at a time (radii are below 64 pixels).
+  float wx[130];
+  for (int x = x0; x <= x1; ++x) wx[x - x0] = filter_.normalized(p_raster.x - (x + 0.5f), 0);
   for (int y = y0; y <= y1; ++y) {
     float wy = filter_.normalized(p_raster.y - (y + 0.5f), 1);
     if (wy == 0.f) continue;
     for (int x = x0; x <= x1; ++x) {
-      float w = wy * filter_.normalized(p_raster.x - (x + 0.5f), 0);
+      float w = wy * wx[x - x0];
       if (w != 0.f) splats_.add(x, y, v * w);
     }
   }

@@ -29,7 +29,7 @@ class PixelFilter {
   /// of a splat at that offset the pixel receives, so that splats are filtered as camera samples are.
   float normalized(float x, int axis) const;
   /// A box of radius 0.5: every point belongs to exactly one pixel, with weight 1.
-  bool single_pixel() const { return type_ == "box" && radius_.x == 0.5f && radius_.y == 0.5f; }
+  bool single_pixel() const { return shape_ == Shape::Box && radius_.x == 0.5f && radius_.y == 0.5f; }
 
  private:
   float sample_axis(float u, int axis, float* weight) const;
@@ -37,6 +37,7 @@ class PixelFilter {
   Vec2 integral_{1.f};  // per axis, the integral of evaluate_axis over [-radius, radius]
   float eval_gaussian(float x, float r) const;
   std::string type_;
+  enum class Shape { Box, Triangle, Gaussian } shape_;  // type_ as decided once (splats ask per pixel)
   Vec2 radius_;
   float sigma_ = 0.5f;
   // Gaussian only: per axis, the inverse CDF at kInverseSize + 1 evenly spaced probabilities, so a
