@@ -1,6 +1,7 @@
 #include "image/exr_layers.h"
 
-#include "util/input_file.h"
+#include "image/image_input.h"
+
 #include "util/output_file.h"
 
 #include <penumbra/error.h>
@@ -66,16 +67,10 @@ void write_layered_exr(const std::string& path, const LayeredImage& image) {
 }
 
 LayeredImage read_layered_exr(const std::string& path) {
-  // Only regular files (util/input_file.h): a device or FIFO named as an image is refused, not read.
-  if (std::string problem = input_file_problem(path); !problem.empty())
-    throw Error(fmt::format("cannot read image '{}': {}", path, problem));
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
+  auto in = open_image_input(path);
   const OIIO::ImageSpec& spec = in->spec();
   size_t nch = size_t(spec.nchannels), npix = size_t(spec.width) * size_t(spec.height);
-  std::vector<float> all(npix * nch);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw Error(fmt::format("cannot read image '{}': {}", path, in->geterror()));
+  std::vector<float> all = read_image_channels(*in, path, spec.nchannels);
 
   LayeredImage image;
   image.width = spec.width;

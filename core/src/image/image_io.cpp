@@ -1,6 +1,7 @@
 #include "image/image_io.h"
 
-#include "util/input_file.h"
+#include "image/image_input.h"
+
 #include "util/output_file.h"
 
 #include <penumbra/error.h>
@@ -222,27 +223,16 @@ void write_image(const std::string& path, const ImageRgb& img,
 }
 
 ImageRgb read_image(const std::string& path, ImageFileInfo* info) {
-  // Only regular files (util/input_file.h): a device or FIFO named as an image is refused, not read.
-  if (std::string problem = input_file_problem(path); !problem.empty())
-    throw Error(fmt::format("cannot read image '{}': {}", path, problem));
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
+  auto in = open_image_input(path);
   const OIIO::ImageSpec& spec = in->spec();
   int channels = spec.nchannels;
-  // A damaged or hostile header must not make us allocate: 2^28 pixels (1 GiB of RGB floats) at most.
-  constexpr double kMaxPixels = 268435456.0;
-  if (spec.width <= 0 || spec.height <= 0 || channels <= 0 || channels > 64 ||
-      static_cast<double>(spec.width) * spec.height > kMaxPixels)
-    throw Error(fmt::format("cannot read image '{}': {}x{} pixels with {} channels is outside what Penumbra reads "
-                            "(at most {:.0f} pixels)",
-                            path, spec.width, spec.height, channels, kMaxPixels));
   if (info) {
     info->integer = !spec.format.is_floating_point();
     info->channels = channels;
   }
-  std::vector<float> all(size_t(spec.width) * spec.height * channels);
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw Error(fmt::format("cannot read image '{}': {}", path, in->geterror()));
+  // Only the channels used: the first three, or the one grey channel repeated.
+  int used = std::min(channels, 3);
+  std::vector<float> all = read_image_channels(*in, path, used);
   in->close();
 
   ImageRgb img;
@@ -251,7 +241,7 @@ ImageRgb read_image(const std::string& path, ImageFileInfo* info) {
   img.pixels.resize(size_t(img.width) * img.height * 3);
   for (size_t p = 0; p < size_t(img.width) * img.height; ++p)
     for (int c = 0; c < 3; ++c)
-      img.pixels[3 * p + c] = all[p * channels + (channels >= 3 ? c : 0)];
+      img.pixels[3 * p + c] = all[p * used + (used == 3 ? c : 0)];
   return img;
 }
 
