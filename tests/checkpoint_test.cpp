@@ -2,6 +2,7 @@
 // render, writes its image and a checkpoint and exits with 75; `--resume` continues, and the result
 // equals the uninterrupted render bit for bit for every integrator (other thread count too). A
 // second signal exits at once; a checkpoint of another render, or a damaged one, is refused.
+#include "render/render_session.h"
 #include "support/command.h"
 
 #include <penumbra/image.h>
@@ -214,3 +215,30 @@ TEST(Checkpoint, UnwritableCheckpointFolderIsAnErrorBeforeRendering) {
 }
 
 }  // namespace
+
+// The race behind a flaky CI run: the handlers were removed when render() returned, so a second
+// signal that arrived while the image was being written killed the process with no message. They
+// now stay installed until the result (and with it the outputs) is done with.
+TEST(Interrupt, HandlersStayInstalledWhileTheOutputsAreWritten) {
+  struct sigaction before {};
+  sigaction(SIGINT, nullptr, &before);
+  ASSERT_EQ(before.sa_handler, SIG_DFL);
+  RenderSettings settings;
+  settings.scene_file = kScene;
+  settings.resolution = std::make_pair(8, 8);
+  settings.spp = 1;
+  settings.quiet = true;
+  settings.output = test::temp_dir("interrupt-lifetime") + "/out.exr";
+  settings.handle_signals = true;
+  std::optional<RenderResult> result = render(settings);
+  struct sigaction during {};
+  sigaction(SIGINT, nullptr, &during);
+  EXPECT_NE(during.sa_handler, SIG_DFL) << "render() returned with the default SIGINT action back";
+  write_outputs(settings, *result);
+  sigaction(SIGINT, nullptr, &during);
+  EXPECT_NE(during.sa_handler, SIG_DFL);
+  result.reset();
+  struct sigaction after {};
+  sigaction(SIGINT, nullptr, &after);
+  EXPECT_EQ(after.sa_handler, SIG_DFL) << "the previous handler comes back once the result is gone";
+}

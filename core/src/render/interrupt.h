@@ -1,6 +1,7 @@
 // SIGINT and SIGTERM during a render: the first asks the render to stop after the current pass
 // (and write its image and a checkpoint); a second ends the process at once. Installed for the
-// duration of one render; the previous handlers come back afterwards.
+// duration of one render and the writing of its outputs (RenderResult::signal_handlers); the
+// previous handlers come back afterwards.
 #pragma once
 
 namespace penumbra {

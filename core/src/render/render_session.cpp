@@ -421,8 +421,8 @@ RenderResult render(const RenderSettings& settings) {
                               built.integrator_name));
     session.restore(read_checkpoint(settings.resume_file, key));
   }
-  std::optional<InterruptGuard> interrupts;
-  if (settings.handle_signals) interrupts.emplace();
+  std::shared_ptr<const InterruptGuard> interrupts;
+  if (settings.handle_signals) interrupts = std::make_shared<const InterruptGuard>();
   session.start();
   built.integrator->render(session);
   double seconds = session.elapsed();
@@ -431,6 +431,7 @@ RenderResult render(const RenderSettings& settings) {
   RenderResult result;
   result.interrupted_by = session.stop_requested() ? InterruptGuard::signal_received() : 0;
   result.checkpoint = session.checkpoint_written();
+  result.signal_handlers = interrupts;
   result.image = built.film->image(session.splat_spp());
   result.aovs = built.film->aov_layers();
   if (built.film->has_splats()) built.structures_built.push_back("film_splat_buffer");

@@ -9,12 +9,14 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace penumbra {
 
+class InterruptGuard;
 class Registry;
 
 /// One integrator parameter set on the command line (`--param NAME=VALUE`, or `/NAME=VALUE` in a
@@ -111,6 +113,10 @@ struct RenderResult {
   ImageRgb image;
   std::vector<ImageLayer> aovs;  // written with the beauty as EXR layers
   RenderStats stats;
+  /// With settings.handle_signals: the SIGINT/SIGTERM handlers installed for the render. They stay
+  /// installed while the result lives, so a second signal while the outputs are written still
+  /// exits at once (with its message) instead of killing the process silently.
+  std::shared_ptr<const InterruptGuard> signal_handlers;
 };
 
 /// Parses, builds and renders. Throws Error for anything the user can fix.
