@@ -118,6 +118,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
   // The filter's weight is left out: the film normalises pixel samples by their summed weights, and
   // SPPM's single sample per pixel and iteration is drawn from the (non-negative) filter itself.
   Rgb beta(1.f);
+  float eta_scale = 1.f;  // product of eta'^2 over the refractions so far (as the path tracer's)
   bool specular_bounce = false;
   int medium = kMediumUnknown;  // the medium `ray` travels in, where known (absorbing media)
   const bool media = scene.has_media();
@@ -179,11 +180,13 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     Vec3 wi = si->shading.to_world(bs->wi);
     if (!consistent_sides(*si, wo, bs->wi, wi)) break;
     beta *= bs->f * std::abs(bs->wi.z) / bs->pdf;
+    if (bs->flags & BsdfTransmission) eta_scale *= sqr(bs->eta);
     specular_bounce = bs->is_specular();
     ray = si->spawn_ray(wi);
     medium = si->media.leaving(si->ng, wi, medium);
     // Roulette only for dim paths: a visible point's throughput multiplies every photon it gathers.
-    float m = max_component(beta);
+    // Radiance compressed inside glass (1/eta'^2) does not count as dim.
+    float m = max_component(beta) * eta_scale;
     if (m < 0.25f) {
       if (u_rr >= m) break;
       beta /= m;
