@@ -10,10 +10,12 @@
 // so neighbouring strategies differ by one factor and p_i / p_s chains along the path (Veach's ratio
 // recurrence, pbrt-v3's MISWeight) instead of evaluating every strategy from scratch.
 //
-// Deltas: a vertex that scattered specularly has delta = true; the densities it generates (pdf_light
-// of the next vertex, pdf_camera of the previous one) are 0 and count as 1 here, since every strategy
-// that can produce the path samples that scattering event in one direction or the other and carries
-// the same delta factor. Strategies that would have to connect through a delta vertex get 0.
+// Deltas: a vertex that scattered specularly has delta = true. The densities it generates (pdf_light
+// of the next vertex, pdf_camera of the previous one) are a delta that every strategy able to produce
+// the path carries once per specular vertex; subpath.cpp stores it as a unit solid-angle density
+// converted to area, so the geometry terms around specular chains stay in the ratios. Densities
+// that are 0 (delta lights' positions, an orthographic camera's direction) count as 1 here.
+// Strategies that would have to connect through a delta vertex get 0.
 //
 // Two strategies do not follow the product rule and are corrected by a factor:
 //  - s = 1 picks x_0 with the light's own sampling seen from x_1 (spherical triangles, cones), not
