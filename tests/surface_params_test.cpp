@@ -51,11 +51,6 @@ TEST(SurfaceDetailErrors, BadDisplacementAndNormalMapTypes) {
               HasSubstr("scene.pbrt:2:20: error: cannot read the normal map"));
 }
 
-TEST(SurfaceDetailErrors, AlphaOnAnAreaLight) {
-  EXPECT_THAT(test::scene_build_error("AreaLightSource \"diffuse\"\n" + std::string(kQuad) + " \"float alpha\" [ 0.5 ]\n"),
-              HasSubstr("scene.pbrt:3:57: error: alpha on a shape with an area light is not supported"));
-}
-
 TEST(SurfaceDetailErrors, MixOfABumpedMaterial) {
   EXPECT_THAT(test::scene_build_error(std::string(kRamp) +
                           "MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"texture displacement\" \"ramp\"\n"

@@ -35,6 +35,11 @@ class Shape {
   /// Density of sample_solid_angle() producing the point p_hit (normal n_hit) in direction wi.
   virtual float pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
                                 const Vec3& n_hit) const = 0;
+  /// Whether the surface is there at a sampled point. False where the shape's alpha cut-out removes
+  /// it (pbrt-v4's AlphaMasked: alpha 0 never there, 1 always, in between when a hash of the point is
+  /// at most alpha). Area lights emit nothing from such samples; rays never hit there. The samplers
+  /// above stay uniform over the whole shape, as pbrt-v4's.
+  virtual bool present(const ShapeSample&) const { return true; }
 };
 
 /// Converts a per-area density at p_light (normal n_light) to per solid angle at p.

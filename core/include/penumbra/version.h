@@ -17,7 +17,8 @@
 //    SurfaceInteraction gained a pixel footprint; Camera::approximate_dp_dxy().
 // 8: absorbing media: SurfaceInteraction::media (MediumInterface), Scene::has_media(),
 //    Scene::transmittance(); Param::from_attribute.
-#define PENUMBRA_SDK_VERSION 8
+// 9: Shape::present() (alpha cut-outs on area lights).
+#define PENUMBRA_SDK_VERSION 9
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

@@ -1,5 +1,7 @@
 #include "scene/alpha_cutout.h"
 
+#include "scene/cutout_shape.h"
+
 #include "scene/quadrics.h"
 #include "scene/sphere.h"
 #include "scene/triangle_mesh.h"
@@ -23,6 +25,15 @@ bool AlphaCutout::keeps(const TextureEvalContext& ctx, const Vec3& o, const Vec3
   if (a >= 1.f) return true;
   if (!(a > 0.f)) return false;
   return alpha_hash(o, d, salt) <= a;
+}
+
+bool CutoutShape::present(const ShapeSample& s) const {
+  TextureEvalContext ctx;
+  ctx.p = s.p;
+  ctx.n = s.n;
+  ctx.uv = s.uv;
+  // pbrt-v4 hashes the point alone; the normal takes the place of the ray direction here.
+  return cutout_.keeps(ctx, s.p, s.n, 0);
 }
 
 uint64_t hit_salt(unsigned geom, unsigned prim, float t) {

@@ -65,7 +65,7 @@ class EmbreeScene final : public Scene {
   const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
 
   /// Keeps the per-triangle shapes that area lights refer to alive as long as the scene.
-  void adopt_shapes(std::vector<std::unique_ptr<Triangle>> shapes) { light_shapes_ = std::move(shapes); }
+  void adopt_shapes(std::vector<std::unique_ptr<Shape>> shapes) { light_shapes_ = std::move(shapes); }
   void set_lights(std::vector<const Light*> lights, std::vector<const Light*> infinite);
   void set_camera(std::unique_ptr<Camera> camera) { camera_ = std::move(camera); }
   /// Builds the BVH. Call once, after all geometry was added.
@@ -129,7 +129,7 @@ class EmbreeScene final : public Scene {
   std::vector<std::unique_ptr<TriangleMesh>> meshes_;
   std::vector<std::unique_ptr<Sphere>> spheres_;
   std::vector<std::unique_ptr<Quadric>> quadrics_;
-  std::vector<std::unique_ptr<Triangle>> light_shapes_;
+  std::vector<std::unique_ptr<Shape>> light_shapes_;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
   std::vector<std::unique_ptr<GeometryUserData>> user_data_;  // Embree callbacks' (quadrics, cut-outs)
   std::vector<const Light*> lights_, infinite_;

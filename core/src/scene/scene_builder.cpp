@@ -1,5 +1,6 @@
 #include "scene/scene_builder.h"
 #include "scene/composite_materials.h"
+#include "scene/cutout_shape.h"
 
 #include "parser/ply_reader.h"
 #include "scene/bilinear_patches.h"
@@ -361,9 +362,6 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       o.tangent_frame = material_anisotropic[i];
     }
     o.cutout = shape_alpha(s.params, s.base_dir, out.texture_table);
-    if (o.cutout.active() && s.area_light >= 0)
-      throw Error(s.params.loc_of("alpha"), "alpha on a shape with an area light is not supported (its emission "
-                                            "would have to be cut out of light sampling too)");
     return o;
   };
   auto invisible = [](const SurfaceOptions& o) { return o.cutout.alpha.is_constant() && o.cutout.alpha.constant() <= 0.f; };
@@ -410,7 +408,14 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     return out.lights.back().get();
   };
   MediaTable media(desc);
-  std::vector<std::unique_ptr<Triangle>> light_triangles;
+  std::vector<std::unique_ptr<Shape>> light_shapes;
+  // The shape an emitter samples: with an alpha cut-out, wrapped so that it emits only where the
+  // surface is there (cutout_shape.h).
+  auto emitter_shape = [&](const Shape* shape, const SurfaceOptions& o) -> const Shape* {
+    if (!o.cutout.active()) return shape;
+    light_shapes.push_back(std::make_unique<CutoutShape>(*shape, o.cutout));
+    return light_shapes.back().get();
+  };
   auto add_mesh = [&](const ShapeEntity& s, std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
                       bool is_textured, bool scene_material = true) {
     SurfaceOptions options = surface_options(s, scene_material);
@@ -424,8 +429,8 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
           lights.push_back(nullptr);
           continue;
         }
-        light_triangles.push_back(std::make_unique<Triangle>(mesh.get(), i));
-        lights.push_back(make_area_light(s, light_triangles.back().get(), total_area));
+        light_shapes.push_back(std::make_unique<Triangle>(mesh.get(), i));
+        lights.push_back(make_area_light(s, emitter_shape(light_shapes.back().get(), options), total_area));
       }
     }
     out.scene->add_mesh(std::move(mesh), bsdf, std::move(lights), is_textured, media.interface_of(s), options);
@@ -456,7 +461,8 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       std::unique_ptr<Sphere> sphere = load_sphere(s);
       SurfaceOptions options = surface_options(s, true);
       if (invisible(options)) return;
-      const Light* light = s.area_light >= 0 ? make_area_light(s, sphere.get(), sphere->area()) : nullptr;
+      const Light* light =
+          s.area_light >= 0 ? make_area_light(s, emitter_shape(sphere.get(), options), sphere->area()) : nullptr;
       out.scene->add_sphere(std::move(sphere), bsdf, light, textured(s), media.interface_of(s), options);
     } else if (s.type == "disk" || s.type == "cylinder") {
       const Bsdf* bsdf = material_of(s);
@@ -468,7 +474,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         if (!quadric->area_is_uniform())
           throw Error(s.loc, "a cylinder area light whose transform stretches its cross-section unevenly is not "
                              "supported (its emission could not be sampled uniformly by area)");
-        light = make_area_light(s, quadric.get(), quadric->area());
+        light = make_area_light(s, emitter_shape(quadric.get(), options), quadric->area());
       }
       out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s), options);
     } else {
@@ -501,7 +507,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     out.scene->add_instance(prototype_of[it - desc.objects.begin()], inst.to_world);
   }
   if (!desc.instances.empty()) out.structures_built.push_back("embree_instances");
-  out.scene->adopt_shapes(std::move(light_triangles));
+  out.scene->adopt_shapes(std::move(light_shapes));
   if (!media.sigma_a().empty()) out.structures_built.push_back("absorbing_media");
   out.scene->set_media(media.sigma_a());
 

@@ -239,8 +239,11 @@ class BdptIntegrator final : public SampleIntegrator {
       if (light_path[i].connectible()) light_ok |= uint64_t(1) << i;
     auto has = [](uint64_t mask, int i) { return i >= 64 || ((mask >> i) & 1); };
     Rgb L(0.f);
+    // s = 1 draws a light point of its own: it runs even when the light subpath is empty (its
+    // emission was cut out by an emitter's alpha, or had no density).
+    const int s_max = std::max(nl, 1);
     for (int t = 1; t <= nc; ++t)
-      for (int s = 0; s <= nl; ++s) {
+      for (int s = 0; s <= s_max; ++s) {
         int depth = s + t - 2;
         if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
         if (s == 0 ? !has(emitter, t - 1)

@@ -1,5 +1,6 @@
 // Area light "diffuse": uniform radiance L leaving the front side of a triangle or sphere (both
-// sides with twosided). Sampled through its shape's solid-angle sampling.
+// sides with twosided). Sampled through its shape's solid-angle sampling; samples where the shape's
+// alpha cut-out removes the surface (Shape::present) emit nothing, as in pbrt-v4.
 //
 // | parameter     | default | meaning                                      |
 // |---------------|---------|----------------------------------------------|
@@ -27,7 +28,7 @@ class DiffuseAreaLight final : public Light {
 
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
     std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, u);
-    if (!ss || !(ss->pdf > 0.f)) return std::nullopt;
+    if (!ss || !(ss->pdf > 0.f) || !shape_->present(*ss)) return std::nullopt;
     Vec3 d = ss->p - ctx.p;
     float len = glm::length(d);
     if (len == 0.f) return std::nullopt;
@@ -45,6 +46,7 @@ class DiffuseAreaLight final : public Light {
   // side chosen with probability 1/2 each when two-sided).
   std::optional<LightLeSample> sample_le(Vec2 u_pos, Vec2 u_dir) const override {
     ShapeSample ss = shape_->sample_area(u_pos);
+    if (!shape_->present(ss)) return std::nullopt;  // cut out by the shape's alpha: no photon
     float side = 1.f;
     if (twosided_) {
       side = u_dir.x < 0.5f ? 1.f : -1.f;
