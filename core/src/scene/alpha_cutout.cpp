@@ -1,7 +1,6 @@
 #include "scene/alpha_cutout.h"
 
 #include "scene/cutout_shape.h"
-
 #include "scene/quadrics.h"
 #include "scene/sphere.h"
 #include "scene/triangle_mesh.h"

@@ -64,7 +64,8 @@ class EmbreeScene final : public Scene {
   /// Meshes and spheres kept for area lights to reference before commit().
   const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
 
-  /// Keeps the per-triangle shapes that area lights refer to alive as long as the scene.
+  /// Keeps the shapes that area lights refer to (per-triangle shapes, cut-out wrappers) alive as
+  /// long as the scene.
   void adopt_shapes(std::vector<std::unique_ptr<Shape>> shapes) { light_shapes_ = std::move(shapes); }
   void set_lights(std::vector<const Light*> lights, std::vector<const Light*> infinite);
   void set_camera(std::unique_ptr<Camera> camera) { camera_ = std::move(camera); }
