@@ -189,19 +189,10 @@ AttributeEnd
                      L, shapes);
 }
 
-struct SeedMean {
-  double mean = 0.0, standard_error = 0.0;
-};
-
-SeedMean mean_over_seeds(const std::string& name, const std::string& text, int runs = 4) {
-  double sum = 0.0, sum2 = 0.0;
-  for (int seed = 1; seed <= runs; ++seed) {
-    double m = test::mean_channel(render_text(fmt::format("{}-{}", name, seed), text, seed), 1);
-    sum += m;
-    sum2 += m * m;
-  }
-  double mean = sum / runs, var = std::max(0.0, (sum2 - runs * mean * mean) / (runs - 1));
-  return SeedMean{mean, std::sqrt(var / runs)};
+test::SeedMean render_over_seeds(const std::string& name, const std::string& text, int runs = 4) {
+  return test::mean_over_seeds(runs, [&](int seed) {
+    return test::mean_channel(render_text(fmt::format("{}-{}", name, seed), text, seed), 1);
+  });
 }
 
 // The 4 of 9 squares of the checkerboard below that stay (floor(s) + floor(t) odd), as quads.
@@ -229,13 +220,13 @@ std::string kept_squares() {
 TEST(AlphaCutout, EmittersAreCutOutOfLightSamplingToo) {
   const std::string board = "Texture \"c\" \"float\" \"checkerboard\" \"float uscale\" [ 3 ] \"float vscale\" [ 3 ] "
                             "\"float tex1\" [ 0 ] \"float tex2\" [ 1 ]";
-  SeedMean squares = mean_over_seeds("emitter-squares", emitter_scene("path", "", "", kept_squares()));
-  SeedMean halved = mean_over_seeds("emitter-halved", emitter_scene("path", "", "", "", 2.f));
+  test::SeedMean squares = render_over_seeds("emitter-squares", emitter_scene("path", "", "", kept_squares()));
+  test::SeedMean halved = render_over_seeds("emitter-halved", emitter_scene("path", "", "", "", 2.f));
   for (const char* integrator : {"path", "bdpt", "lighttracing", "sppm"}) {
     for (auto [what, alpha, textures, reference] :
          {std::tuple{"checkerboard", "\"texture alpha\" \"c\"", board, squares},
           std::tuple{"alpha 0.5", "\"float alpha\" [ 0.5 ]", std::string(), halved}}) {
-      SeedMean cut = mean_over_seeds(fmt::format("emitter-{}-{}", integrator, what == std::string("alpha 0.5")),
+      test::SeedMean cut = render_over_seeds(fmt::format("emitter-{}-{}", integrator, what == std::string("alpha 0.5")),
                                      emitter_scene(integrator, textures, alpha));
       double tol = 4.0 * std::hypot(cut.standard_error, reference.standard_error);
       fmt::print("{} {}: {:.5f} against {:.5f} ({:+.2f} %), tolerance {:.2f} %\n", integrator, what, cut.mean,

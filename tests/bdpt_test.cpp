@@ -336,26 +336,14 @@ void expect_clean(const RenderResult& r, const std::string& what) {
   EXPECT_EQ(test::count_nonfinite(r.image), 0) << what;
 }
 
-struct SeedMean {
-  double mean = 0.0;
-  double standard_error = 0.0;  // of the mean, from the spread of the runs
-};
-
-// `measure` of the image rendered with seeds 1..runs (each checked for non-finite values): the mean
-// over the runs and its standard error. Whole-image means of independent runs measure the error
-// even where splats correlate neighbouring pixels.
-SeedMean mean_over_seeds(const std::string& file, const std::string& integrator, int spp, int w, int h, int runs,
-                         const std::function<double(const ImageRgb&)>& measure) {
-  double sum = 0.0, sum2 = 0.0;
-  for (int seed = 1; seed <= runs; ++seed) {
+// test::mean_over_seeds of `measure` on renders of `file` (each checked for non-finite values).
+test::SeedMean render_over_seeds(const std::string& file, const std::string& integrator, int spp, int w, int h,
+                                 int runs, const std::function<double(const ImageRgb&)>& measure) {
+  return test::mean_over_seeds(runs, [&](int seed) {
     RenderResult r = render_scene(file, integrator, spp, w, h, seed);
     expect_clean(r, integrator.empty() ? file : integrator);
-    double m = measure(r.image);
-    sum += m;
-    sum2 += m * m;
-  }
-  double mean = sum / runs, var = std::max(0.0, (sum2 - runs * mean * mean) / (runs - 1));
-  return SeedMean{mean, std::sqrt(var / runs)};
+    return measure(r.image);
+  });
 }
 
 double green_mean(const ImageRgb& image) { return test::mean_channel(image, 1); }
@@ -462,7 +450,7 @@ TEST(Bdpt, FurnaceSphereRendersLeOverOneMinusAlbedo) {
   const int runs = 8;
   for (auto [integrator, spp] : {std::pair{"bdpt", 8}, std::pair{"lighttracing", 512}}) {
     std::string file = write_scene(std::string("furnace-") + integrator, furnace_scene(0.5f, 200, integrator));
-    auto [mean, se] = mean_over_seeds(file, "", spp, 16, 16, runs, green_mean);
+    auto [mean, se] = render_over_seeds(file, "", spp, 16, 16, runs, green_mean);
     double tol = 4.0 * se + 1e-6;
     std::printf("furnace %-12s mean %.5f, 4 standard errors %.5f\n", integrator, mean, tol);
     EXPECT_NEAR(mean, 2.0, tol) << integrator;
@@ -485,7 +473,7 @@ TEST(Bdpt, MaxDepthTruncatesSeriesExactly) {
   for (auto [integrator, spp] : {std::pair{"bdpt", 16}, std::pair{"lighttracing", 1024}})
     for (int depth : {0, 1, 2, 5}) {
       std::string file = write_scene(fmt::format("series-{}-{}", integrator, depth), furnace_scene(a, depth, integrator));
-      auto [mean, se] = mean_over_seeds(file, "", spp, 16, 16, runs, green_mean);
+      auto [mean, se] = render_over_seeds(file, "", spp, 16, 16, runs, green_mean);
       double tol = 4.0 * se + 1e-6;
       EXPECT_NEAR(mean, series(depth), tol) << integrator << " maxdepth " << depth;
       EXPECT_GT(std::abs(mean - series(depth + 1)), tol) << integrator << " maxdepth " << depth << " vs " << depth + 1;
@@ -634,8 +622,8 @@ AttributeBegin
 AttributeEnd
 )");
   auto whole = [](const ImageRgb& image) { return block_mean(image, 0, 0, image.width, image.height); };
-  SeedMean path = mean_over_seeds(file, "path", 1024, 24, 24, 6, whole);
-  SeedMean bdpt = mean_over_seeds(file, "bdpt", 256, 24, 24, 6, whole);
+  test::SeedMean path = render_over_seeds(file, "path", 1024, 24, 24, 6, whole);
+  test::SeedMean bdpt = render_over_seeds(file, "bdpt", 256, 24, 24, 6, whole);
   double tol = 4.0 * std::hypot(path.standard_error, bdpt.standard_error);
   fmt::print("glass caustic: bdpt {:.5f} (standard error {:.3f} %), path {:.5f} ({:.3f} %): {:+.2f} %, tolerance {:.2f} %\n",
              bdpt.mean, 100 * bdpt.standard_error / bdpt.mean, path.mean, 100 * path.standard_error / path.mean,

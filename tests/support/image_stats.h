@@ -3,7 +3,9 @@
 
 #include "image/image_io.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace penumbra::test {
 
@@ -24,6 +26,25 @@ inline double standard_error_of_mean(const ImageRgb& img, int c) {
   size_t n = img.pixels.size() / 3;
   for (size_t i = 0; i < n; ++i) sum2 += (img.pixels[3 * i + c] - mean) * (img.pixels[3 * i + c] - mean);
   return std::sqrt(sum2 / (n - 1) / n);
+}
+
+struct SeedMean {
+  double mean = 0.0;
+  double standard_error = 0.0;  // of the mean, from the spread of the runs
+};
+
+/// The mean of measure(seed) over seeds 1..runs (runs >= 2) and its standard error: for agreement
+/// tests whose tolerance comes from measured variance. Whole-image means of independent renders
+/// measure the error even where splats correlate neighbouring pixels.
+inline SeedMean mean_over_seeds(int runs, const std::function<double(int seed)>& measure) {
+  double sum = 0.0, sum2 = 0.0;
+  for (int seed = 1; seed <= runs; ++seed) {
+    double m = measure(seed);
+    sum += m;
+    sum2 += m * m;
+  }
+  double mean = sum / runs, var = std::max(0.0, (sum2 - runs * mean * mean) / (runs - 1));
+  return SeedMean{mean, std::sqrt(var / runs)};
 }
 
 inline int count_nonfinite(const ImageRgb& img) {
