@@ -25,11 +25,25 @@ struct DirectSamples {
   Vec2 u_dir;
 };
 
+// The infinite lights a BSDF-sampled ray that escapes the scene sees, weighted against light sampling.
+Rgb escaped_light(const Scene& scene, const Ray& ray, const LightSampleContext& lctx, const Vec3& wi,
+                  const Rgb& weight, float bsdf_pdf) {
+  Rgb L(0.f);
+  SurfaceInteraction none;
+  for (const Light* light : scene.infinite_lights()) {
+    Rgb Le = light->Le(ray);
+    if (is_black(Le)) continue;
+    float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, none);
+    L += weight * Le * power_heuristic(1, bsdf_pdf, 1, light_pdf);
+  }
+  return L;
+}
+
 // Light sampling weighted against BSDF sampling, and BSDF sampling weighted against light sampling
 // (power heuristic); the BSDF ray counts any emitter it finds, whose light-sampling density is
 // pmf(light) * pdf_li, exactly as in the path integrator.
 Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
-                 const Scene& scene, const DirectSamples& u, bool rays_find_lights, int arrived_in) {
+                 const Scene& scene, const DirectSamples& u, RaysFind rays_find, int arrived_in) {
   Rgb L(0.f);
   LightSampleContext lctx{si.p, si.ng};
   if (std::optional<SampledLight> sl = scene.sample_light(u.u_light)) {
@@ -51,7 +65,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
 
   // With only point, spot and distant lights a BSDF-sampled ray finds no emitter: it would add
   // nothing, so it is not traced (its random numbers are drawn all the same).
-  if (!rays_find_lights) return L;
+  if (rays_find == RaysFind::Nothing) return L;
   std::optional<BsdfSample> bs = bsdf.sample_f(wo, u.u_lobe, u.u_dir, sctx);
   // A specular lobe cannot meet light sampling; the path continues through it instead (or, at a
   // visible point, that lobe is not followed, as in pbrt).
@@ -60,6 +74,12 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
   if (!consistent_sides(si, wo, bs->wi, wi)) return L;
   Rgb weight = bs->f * std::abs(bs->wi.z) / bs->pdf;
   Ray ray = si.spawn_ray(wi);
+  // Where only the sky emits, a ray that hits anything adds nothing: whether it escapes is enough
+  // (an any-hit query, and no hit record to build).
+  if (rays_find == RaysFind::Environment) {
+    if (scene.occluded(ray)) return L;
+    return L + escaped_light(scene, ray, lctx, wi, weight, bs->pdf);
+  }
   std::optional<SurfaceInteraction> hit = scene.intersect(ray);
   if (scene.has_media())
     weight *= scene.segment_transmittance(si.media.leaving(si.ng, wi, arrived_in),
@@ -74,13 +94,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
       }
     }
   } else {
-    SurfaceInteraction none;
-    for (const Light* light : scene.infinite_lights()) {
-      Rgb Le = light->Le(ray);
-      if (is_black(Le)) continue;
-      float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, none);
-      L += weight * Le * power_heuristic(1, bs->pdf, 1, light_pdf);
-    }
+    L += escaped_light(scene, ray, lctx, wi, weight, bs->pdf);
   }
   return L;
 }
@@ -104,14 +118,15 @@ int draws_until_not_specular(const Bsdf& bsdf, const Vec3& wo, const ShadingCont
 
 }  // namespace
 
-bool rays_can_find_lights(const Scene& scene) {
+RaysFind what_rays_find(const Scene& scene) {
   for (const Light* light : scene.lights())
-    if (!is_delta_light(light->type())) return true;
-  return !scene.infinite_lights().empty();
+    if (light->type() == LightType::Area) return RaysFind::Anything;
+  if (scene.infinite_lights().empty()) return RaysFind::Nothing;
+  return scene.has_media() ? RaysFind::Anything : RaysFind::Environment;
 }
 
 CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth,
-                                   bool rays_find_lights) {
+                                   RaysFind rays_find) {
   CameraPathResult out;
   Ray ray = camera_ray;
   float distance = 0.f;
@@ -149,7 +164,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     if (flags == 0) break;
     Vec3 wo = si->shading.to_local(si->wo);
     ShadingContext sctx{si->texture_context(), TransportMode::Radiance};
-    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find_lights, medium);
+    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find, medium);
 
     // The continuation; a BSDF with diffuse and delta lobes needs it for the decision below.
     const bool diffuse = flags & BsdfDiffuse, has_delta = flags & BsdfSpecular;

@@ -10,6 +10,13 @@
 
 namespace penumbra::sppm {
 
+/// What a BSDF-sampled direct-light ray can find, which decides how it is traced.
+enum class RaysFind {
+  Nothing,     // only point, spot and distant lights: the ray is not traced
+  Environment, // infinite lights only, no media: an occlusion test tells whether the ray escapes
+  Anything,    // area lights (or media on the way): the closest hit is needed
+};
+
 struct CameraPathResult {
   Rgb Ld{0.f};       // emission seen along the prefix plus direct light at its non-specular vertices
   VisiblePoint vp;   // vp.bsdf == nullptr when the path found no diffuse surface
@@ -22,12 +29,11 @@ struct CameraPathResult {
 /// (light 1 + 2, direct-light BSDF sample 1 + 2, continuation 1 + 2, roulette 1), drawn whether used
 /// or not so that quasi-random samplers keep their dimensions aligned across paths. A visible point
 /// on a BSDF with delta and diffuse lobes draws 3 more per extra BSDF sample after the last bounce's.
-/// `rays_find_lights` is rays_can_find_lights(scene): false skips the BSDF-sampled direct-light ray,
-/// which could find no emitter.
+/// `rays_find` is what_rays_find(scene): which emitters a BSDF-sampled direct-light ray can find.
 CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth,
-                                   bool rays_find_lights = true);
+                                   RaysFind rays_find = RaysFind::Anything);
 
-/// Whether any light can be hit by a ray: an area or infinite light (not only point, spot and distant).
-bool rays_can_find_lights(const Scene& scene);
+/// Which emitters a ray can find in `scene`.
+RaysFind what_rays_find(const Scene& scene);
 
 }  // namespace penumbra::sppm

@@ -114,7 +114,7 @@ class SppmIntegrator final : public SampleIntegrator {
   uint64_t photons_ = 0, photon_stream_ = 0;
   double quantum_ = 1.0, inv_quantum_ = 1.0;
   bool trace_photons_ = false;
-  bool rays_find_lights_ = true;    // false: only delta lights, no BSDF-sampled direct-light ray
+  RaysFind rays_find_ = RaysFind::Anything;  // what a BSDF-sampled direct-light ray can find
   std::vector<VisiblePoint> vps_;
   std::vector<Vec3> vp_p_;
   std::vector<float> vp_radius_;    // 0 where a pixel has no visible point this iteration
@@ -156,7 +156,7 @@ void SppmIntegrator::begin_render(RenderContext& ctx) {
   inv_quantum_ = 1.0 / quantum_;
   // One bounce is all direct light; photons start to matter from two.
   trace_photons_ = max_depth_ >= 2 && photons_ > 0 && total_power > 0.0;
-  rays_find_lights_ = rays_can_find_lights(scene);
+  rays_find_ = what_rays_find(scene);
   // Per-pixel state, announced before it is allocated: the visible point and its split-out position,
   // radius and direct light, the statistics, the photon accumulator, the footprint, one gather point
   // and, per point in the grid, a 16-byte entry, its index, its bucket and up to 8 bytes of bucket table.
@@ -185,7 +185,7 @@ Rgb SppmIntegrator::sample(const Scene& scene, const PixelSample& ps, Sampler& s
   vp_radius_[i] = 0.f;
   vp_Ld_[i] = Rgb(0.f);
   if (!ps.ray) return Rgb(0.f);
-  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_, rays_find_lights_);
+  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_, rays_find_);
   vp_Ld_[i] = r.Ld;
   bool valid = r.vp.bsdf && is_finite(r.p) && is_finite(r.vp.beta) && !is_black(r.vp.beta);
   if (!valid) return Rgb(0.f);
