@@ -150,10 +150,10 @@ TEST(Cli, UndefinedNamedMaterialIsLocated) {
 }
 
 TEST(Cli, UnsupportedShapeIsLocated) {
-  auto r = render_text("curve", scene_with("", "Shape \"curve\"\n"));
+  auto r = render_text("heightfield", scene_with("", "Shape \"heightfield\"\n"));  // pbrt-v3's, gone from pbrt-v4
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: unsupported shape 'curve'; available: bilinearmesh, cylinder, disk, gltf, "
-                               "loopsubdiv, plymesh, sphere, trianglemesh"));
+  EXPECT_THAT(r.err, HasSubstr("scene.pbrt:5:1: error: unsupported shape 'heightfield'; available: bilinearmesh, curve, cylinder, "
+                               "disk, gltf, loopsubdiv, plymesh, sphere, trianglemesh"));
 }
 
 TEST(Cli, KnownButUnsupportedPbrtParameterSaysSo) {

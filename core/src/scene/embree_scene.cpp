@@ -160,6 +160,38 @@ void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf
   quadrics_.push_back(std::move(quadric));
 }
 
+void EmbreeScene::add_curves(std::unique_ptr<Curves> curves, const Bsdf* bsdf, bool textured, MediumInterface media,
+                             const SurfaceOptions& options) {
+  const bool ribbon = curves->type == CurveType::Ribbon;
+  RTCGeometry geom =
+      rtcNewGeometry(device_, ribbon ? RTC_GEOMETRY_TYPE_NORMAL_ORIENTED_BEZIER_CURVE : RTC_GEOMETRY_TYPE_FLAT_BEZIER_CURVE);
+  const size_t n = curves->control.size();
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                        4 * sizeof(float), n));
+  for (size_t i = 0; i < n; ++i) {
+    const Vec4& c = curves->control[i];
+    for (int k = 0; k < 4; ++k) v[4 * i + k] = c[k];
+    target_bounds().extend(Vec3(c) - Vec3(c.w));
+    target_bounds().extend(Vec3(c) + Vec3(c.w));
+  }
+  if (ribbon) {
+    auto* nb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3,
+                                                           3 * sizeof(float), n));
+    for (size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) nb[3 * i + k] = curves->normals[i][k];
+  }
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
+                                                             sizeof(uint32_t), curves->segment_count()));
+  for (size_t i = 0; i < curves->segment_count(); ++i) idx[i] = static_cast<uint32_t>(4 * i);
+  rtcSetGeometryTessellationRate(geom, static_cast<float>(curves->tessellation));
+  Geometry g;
+  g.curves = curves.get();
+  SurfaceOptions o = options;
+  o.tangent_frame = true;  // pbrt-v4's frame: x along the strand (hair BSDFs and anisotropy need it)
+  attach(geom, std::move(g), bsdf, textured, media, o);
+  curves_.push_back(std::move(curves));
+}
+
 void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const Light*> infinite) {
   lights_ = std::move(lights);
   infinite_ = std::move(infinite);
@@ -285,6 +317,16 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
     si.ns = s.ns;
     si.uv = s.uv;
     if (g.tangent_frame) g.mesh->uv_derivatives(rh.hit.primID, &dpdu, &dpdv);
+  } else if (g.curves) {
+    Curves::Surface s = g.curves->surface(rh.hit.primID, rh.hit.u, rh.hit.v, local.o + si.t * local.d,
+                                          glm::normalize(local.d), Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+    dpdu = s.dpdu;
+    dpdv = s.dpdv;
+    si.p = s.p;
+    si.p_error = s.p_error;
+    si.ng = s.ng;
+    si.ns = s.ns;
+    si.uv = s.uv;
   } else if (g.quadric) {
     Quadric::Surface s = g.quadric->surface_at(local, si.t);
     dpdu = s.dpdu;

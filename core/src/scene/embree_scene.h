@@ -8,6 +8,7 @@
 #include <penumbra/scene.h>
 
 #include "scene/alpha_cutout.h"
+#include "scene/curves.h"
 #include "scene/quadrics.h"
 #include "scene/sphere.h"
 #include "scene/surface_detail.h"
@@ -46,6 +47,9 @@ class EmbreeScene final : public Scene {
   /// Multiplies the texture footprint: pbrt-v4's max(1/8, 1/sqrt(spp)), since many samples per pixel
   /// already average what a wider filter would. 1 until set.
   void set_texture_footprint_scale(float s) { footprint_scale_ = s; }
+  /// Adds pbrt-v4 curves as Embree Bezier curves (flat and cylinder: ray-facing; ribbon: oriented).
+  void add_curves(std::unique_ptr<Curves> curves, const Bsdf* bsdf, bool textured = false, MediumInterface media = {},
+                  const SurfaceOptions& options = {});
   void add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light, bool textured = false,
                    MediumInterface media = {}, const SurfaceOptions& options = {});
   /// Object instancing (pbrt-v4's ObjectBegin/ObjectInstance through Embree instances: one copy of
@@ -89,6 +93,7 @@ class EmbreeScene final : public Scene {
     const TriangleMesh* mesh = nullptr;  // one of these two
     const Sphere* sphere = nullptr;
     const Quadric* quadric = nullptr;
+    const Curves* curves = nullptr;
     const Bsdf* bsdf = nullptr;
     std::vector<const Light*> lights;    // per primitive, or empty
     bool textured = false;
@@ -130,6 +135,7 @@ class EmbreeScene final : public Scene {
   std::vector<std::unique_ptr<TriangleMesh>> meshes_;
   std::vector<std::unique_ptr<Sphere>> spheres_;
   std::vector<std::unique_ptr<Quadric>> quadrics_;
+  std::vector<std::unique_ptr<Curves>> curves_;
   std::vector<std::unique_ptr<Shape>> light_shapes_;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
   std::vector<std::unique_ptr<GeometryUserData>> user_data_;  // Embree callbacks' (quadrics, cut-outs)

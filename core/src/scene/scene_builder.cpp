@@ -477,8 +477,15 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
         light = make_area_light(s, emitter_shape(quadric.get(), options), quadric->area());
       }
       out.scene->add_quadric(std::move(quadric), bsdf, light, textured(s), media.interface_of(s), options);
+    } else if (s.type == "curve") {
+      if (s.area_light >= 0)
+        throw Error(s.loc, "an area light on a curve is not supported (pbrt-v4 cannot sample curves either)");
+      const Bsdf* bsdf = material_of(s);
+      auto curves = std::make_unique<Curves>(load_curves(s));
+      SurfaceOptions options = surface_options(s, true);
+      out.scene->add_curves(std::move(curves), bsdf, textured(s), media.interface_of(s), options);
     } else {
-      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: bilinearmesh, cylinder, disk, gltf, loopsubdiv, plymesh, sphere, "
+      throw Error(s.loc, fmt::format("unsupported shape '{}'; available: bilinearmesh, curve, cylinder, disk, gltf, loopsubdiv, plymesh, sphere, "
                                      "trianglemesh",
                                      s.type));
     }
