@@ -86,6 +86,7 @@ ChiSquareResult bsdf_chi_square(const Bsdf& bsdf, const Vec3& wo, int n, uint64_
                                 const BsdfChiSquareOptions& options) {
   ShadingContext ctx;
   ctx.mode = options.mode;
+  ctx.tex = options.tex;
   // The chart's frame: the identity, or rotated so that a narrow lobe's peak sits at +z, where the
   // cap z >= z_min is cut into many cells. Rotations preserve solid angle, so the pdf needs no Jacobian.
   Frame frame;
@@ -163,9 +164,11 @@ ChiSquareResult bsdf_chi_square(const Bsdf& bsdf, const Vec3& wo, int n, uint64_
   return r;
 }
 
-AlbedoEstimate albedo_estimate(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t seed, TransportMode mode) {
+AlbedoEstimate albedo_estimate(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t seed, TransportMode mode,
+                               const TextureEvalContext& tex) {
   ShadingContext ctx;
   ctx.mode = mode;
+  ctx.tex = tex;
   Pcg32 rng(seed);
   glm::dvec3 sum(0.0), sum2(0.0);
   AlbedoEstimate e;
@@ -211,9 +214,11 @@ double reciprocity_error(const Bsdf& bsdf, int n_pairs, uint64_t seed) {
   return worst;
 }
 
-PdfConsistency pdf_consistency(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t seed, TransportMode mode) {
+PdfConsistency pdf_consistency(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t seed, TransportMode mode,
+                               const TextureEvalContext& tex) {
   ShadingContext ctx;
   ctx.mode = mode;
+  ctx.tex = tex;
   Pcg32 rng(seed);
   PdfConsistency r;
   for (int i = 0; i < n; ++i) {

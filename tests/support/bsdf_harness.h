@@ -35,6 +35,7 @@ struct BsdfChiSquareOptions {
   bool zoom = true;
   int max_refinements = 6;  // depth of the adaptive integration of the pdf over a cell
   TransportMode mode = TransportMode::Radiance;
+  TextureEvalContext tex;  // where on the surface (BSDFs that depend on uv: hair's offset h)
 };
 
 /// Chi-square test of sample_f(wo, ...) against pdf(wo, .) over the full sphere (transmission goes
@@ -73,7 +74,7 @@ double ggx_albedo_by_quadrature(double alpha, double cos_o);
 /// Monte Carlo estimate of the directional albedo int f(wo, wi) |cos theta_i| dwi with the BSDF's
 /// own sampling, specular lobes included (weight f |cos| / pdf). Absent samples count as zero.
 AlbedoEstimate albedo_estimate(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t seed = 11,
-                               TransportMode mode = TransportMode::Radiance);
+                               TransportMode mode = TransportMode::Radiance, const TextureEvalContext& tex = {});
 inline Rgb albedo(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t seed = 11,
                   TransportMode mode = TransportMode::Radiance) {
   return albedo_estimate(bsdf, wo, n, seed, mode).mean;
@@ -92,6 +93,6 @@ struct PdfConsistency {
 /// Draws n samples from sample_f(wo, ...) and compares the returned pdf and f with what pdf() and
 /// f() say for the same direction. Specular samples are skipped.
 PdfConsistency pdf_consistency(const Bsdf& bsdf, const Vec3& wo, int n, uint64_t seed = 17,
-                               TransportMode mode = TransportMode::Radiance);
+                               TransportMode mode = TransportMode::Radiance, const TextureEvalContext& tex = {});
 
 }  // namespace penumbra::test

@@ -162,6 +162,8 @@ void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf
 
 void EmbreeScene::add_curves(std::unique_ptr<Curves> curves, const Bsdf* bsdf, bool textured, MediumInterface media,
                              const SurfaceOptions& options) {
+  has_curves_ = true;
+  for (const Vec4& c : curves->control) curve_back_ = std::max(curve_back_, 2.5f * c.w);
   const bool ribbon = curves->type == CurveType::Ribbon;
   RTCGeometry geom =
       rtcNewGeometry(device_, ribbon ? RTC_GEOMETRY_TYPE_NORMAL_ORIENTED_BEZIER_CURVE : RTC_GEOMETRY_TYPE_FLAT_BEZIER_CURVE);
@@ -286,13 +288,33 @@ static RTCRayHit make_rayhit(const Ray& ray) {
   return rh;
 }
 
+// Embree ignores curve hits closer to the ray's origin than about two radii (its self-intersection
+// avoidance), which would hide a neighbouring strand that pbrt-v4 sees. With curves in the scene the
+// ray reaches Embree with a unit direction, its origin moved back along it by `back` (more than two of
+// the largest radius) and tnear = back, so the blind zone lies before the ray's real start.
+RTCRayHit EmbreeScene::embree_ray(const Ray& ray, float* t_scale, float* t_shift) const {
+  *t_scale = 1.f;
+  *t_shift = 0.f;
+  if (!has_curves_) return make_rayhit(ray);
+  float len = glm::length(ray.d);
+  if (!(len > 0.f) || !std::isfinite(len)) return make_rayhit(ray);
+  Vec3 d = ray.d / len;
+  RTCRayHit rh = make_rayhit(Ray{ray.o - curve_back_ * d, d, ray.tmax * len + curve_back_});
+  rh.ray.tnear = curve_back_;
+  *t_scale = len;
+  *t_shift = curve_back_;
+  return rh;
+}
+
 std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   count_ray();
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRayHit rh = make_rayhit(ray);
+  float t_scale, t_shift;
+  RTCRayHit rh = embree_ray(ray, &t_scale, &t_shift);
   rtcIntersect1(scene_, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  if (has_curves_) rh.ray.tfar = (rh.ray.tfar - t_shift) / t_scale;
 
   // A hit inside an instance is computed in the prototype's space and then placed.
   const Instance* inst = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[rh.hit.instID[0]] : nullptr;
@@ -420,7 +442,8 @@ bool EmbreeScene::occluded(const Ray& ray) const {
   count_ray();
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRay r = make_rayhit(ray).ray;
+  float t_scale, t_shift;
+  RTCRay r = embree_ray(ray, &t_scale, &t_shift).ray;
   rtcOccluded1(scene_, &ctx, &r);
   return r.tfar < 0.f;
 }

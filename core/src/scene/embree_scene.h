@@ -117,6 +117,7 @@ class EmbreeScene final : public Scene {
   std::vector<Geometry>& target_geometries() { return target_ < 0 ? geometries_ : prototypes_[target_].geometries; }
   Bounds3& target_bounds() { return target_ < 0 ? bounds_ : prototypes_[target_].bounds; }
   void place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const;
+  RTCRayHit embree_ray(const Ray& ray, float* t_scale, float* t_shift) const;
   void attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
               const SurfaceOptions& options);
   void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;
@@ -136,6 +137,8 @@ class EmbreeScene final : public Scene {
   std::vector<std::unique_ptr<Sphere>> spheres_;
   std::vector<std::unique_ptr<Quadric>> quadrics_;
   std::vector<std::unique_ptr<Curves>> curves_;
+  bool has_curves_ = false;  // rays then reach Embree moved back by curve_back_ (see embree_ray())
+  float curve_back_ = 0.f;
   std::vector<std::unique_ptr<Shape>> light_shapes_;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
   std::vector<std::unique_ptr<GeometryUserData>> user_data_;  // Embree callbacks' (quadrics, cut-outs)

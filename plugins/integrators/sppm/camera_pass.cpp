@@ -52,7 +52,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
       Vec3 wi = si.shading.to_local(ls->wi);
       Rgb f = bsdf.f(wo, wi, sctx) * std::abs(wi.z);
       if (!is_black(f) && consistent_sides(si, wo, wi, ls->wi) &&
-          !scene.occluded(spawn_ray_to(si.p, si.ng, ls->p_light, ls->n_light))) {
+          !scene.occluded(si.spawn_ray_to(ls->p_light, ls->n_light))) {
         if (scene.has_media())
           f *= scene.segment_transmittance(si.media.leaving(si.ng, ls->wi, arrived_in), kMediumUnknown,
                                            glm::length(ls->p_light - si.p));
