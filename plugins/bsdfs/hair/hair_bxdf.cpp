@@ -160,37 +160,36 @@ std::array<float, kPMax + 1> HairBxdf::attenuation_pdf(float cos_theta_o) const 
   return pdf;
 }
 
-Rgb HairBxdf::f(const Vec3& wo, const Vec3& wi) const {
+float HairBxdf::gamma_t(float sin_theta_o, float cos_theta_o) const {
+  float etap = std::sqrt(std::max(sqr(p_.eta) - sqr(sin_theta_o), 1e-12f)) / std::max(cos_theta_o, 1e-6f);
+  return safe_asin(p_.h / etap);
+}
+
+// sum_p M_p N_p weight[p] (the last term's azimuth uniform): f with A_p as weights, pdf with the
+// probabilities of choosing each term.
+template <class T>
+T HairBxdf::lobe_sum(const Vec3& wo, const Vec3& wi, const std::array<T, kPMax + 1>& weight) const {
   Angles o = angles_of(wo), i = angles_of(wi);
-  float etap = std::sqrt(std::max(sqr(p_.eta) - sqr(o.sin_theta), 1e-12f)) / std::max(o.cos_theta, 1e-6f);
-  float gamma_t = safe_asin(p_.h / etap);
+  float g_t = gamma_t(o.sin_theta, o.cos_theta);
   float phi = i.phi - o.phi;
-  std::array<Rgb, kPMax + 1> ap = attenuation(o.cos_theta);
-  Rgb sum(0.f);
+  T sum(0.f);
   for (int p = 0; p < kPMax; ++p) {
     float sin_p, cos_p;
     tilt(p, o.sin_theta, o.cos_theta, &sin_p, &cos_p);
-    sum += longitudinal(i.cos_theta, cos_p, i.sin_theta, sin_p, v_[p]) * ap[p] * azimuthal(phi, p, s_, gamma_o_, gamma_t);
+    sum += longitudinal(i.cos_theta, cos_p, i.sin_theta, sin_p, v_[p]) * weight[p] * azimuthal(phi, p, s_, gamma_o_, g_t);
   }
-  sum += longitudinal(i.cos_theta, o.cos_theta, i.sin_theta, o.sin_theta, v_[kPMax]) * ap[kPMax] / (2.f * Pi);
+  sum += longitudinal(i.cos_theta, o.cos_theta, i.sin_theta, o.sin_theta, v_[kPMax]) * weight[kPMax] / (2.f * Pi);
+  return sum;
+}
+
+Rgb HairBxdf::f(const Vec3& wo, const Vec3& wi) const {
+  Rgb sum = lobe_sum(wo, wi, attenuation(angles_of(wo).cos_theta));
   if (std::abs(wi.z) > 0.f) sum /= std::abs(wi.z);
   return sum;
 }
 
 float HairBxdf::pdf(const Vec3& wo, const Vec3& wi) const {
-  Angles o = angles_of(wo), i = angles_of(wi);
-  float etap = std::sqrt(std::max(sqr(p_.eta) - sqr(o.sin_theta), 1e-12f)) / std::max(o.cos_theta, 1e-6f);
-  float gamma_t = safe_asin(p_.h / etap);
-  float phi = i.phi - o.phi;
-  std::array<float, kPMax + 1> ap = attenuation_pdf(o.cos_theta);
-  float pdf = 0.f;
-  for (int p = 0; p < kPMax; ++p) {
-    float sin_p, cos_p;
-    tilt(p, o.sin_theta, o.cos_theta, &sin_p, &cos_p);
-    pdf += longitudinal(i.cos_theta, cos_p, i.sin_theta, sin_p, v_[p]) * ap[p] * azimuthal(phi, p, s_, gamma_o_, gamma_t);
-  }
-  pdf += longitudinal(i.cos_theta, o.cos_theta, i.sin_theta, o.sin_theta, v_[kPMax]) * ap[kPMax] / (2.f * Pi);
-  return pdf;
+  return lobe_sum(wo, wi, attenuation_pdf(angles_of(wo).cos_theta));
 }
 
 std::optional<HairSample> HairBxdf::sample_f(const Vec3& wo, float uc, Vec2 u) const {
@@ -215,9 +214,9 @@ std::optional<HairSample> HairBxdf::sample_f(const Vec3& wo, float uc, Vec2 u) c
   float sin_theta_i = -cos_theta * sin_p + sin_theta * cos_phi * cos_p;
   float cos_theta_i = safe_sqrt(1.f - sqr(sin_theta_i));
   // phi_i from N_p.
-  float etap = std::sqrt(std::max(sqr(p_.eta) - sqr(o.sin_theta), 1e-12f)) / std::max(o.cos_theta, 1e-6f);
-  float gamma_t = safe_asin(p_.h / etap);
-  float dphi = p < kPMax ? exit_azimuth(p, gamma_o_, gamma_t) + sample_trimmed_logistic(uc, s_, -Pi, Pi) : 2.f * Pi * uc;
+  float dphi = p < kPMax ? exit_azimuth(p, gamma_o_, gamma_t(o.sin_theta, o.cos_theta)) +
+                               sample_trimmed_logistic(uc, s_, -Pi, Pi)
+                         : 2.f * Pi * uc;
   float phi_i = o.phi + dphi;
   Vec3 wi(sin_theta_i, cos_theta_i * std::cos(phi_i), cos_theta_i * std::sin(phi_i));
   float pdf_value = pdf(wo, wi);

@@ -62,6 +62,10 @@ class HairBxdf {
   // The lobe of term p: sin and cos of theta_o rotated by the cuticle tilt of that term.
   void tilt(int p, float sin_theta_o, float cos_theta_o, float* sin_p, float* cos_p) const;
   std::array<float, kPMax + 1> attenuation_pdf(float cos_theta_o) const;
+  // The azimuth gamma_t of the refracted ray inside the fibre.
+  float gamma_t(float sin_theta_o, float cos_theta_o) const;
+  template <class T>
+  T lobe_sum(const Vec3& wo, const Vec3& wi, const std::array<T, kPMax + 1>& weight) const;
 
   HairParams p_;
   float gamma_o_;
