@@ -85,14 +85,17 @@ Curves::Surface Curves::surface(size_t segment, float t, float v, const Vec3& p,
   if (!(glm::dot(tangent, tangent) > 0.f)) tangent = Vec3(control[4 * segment + 3] - control[4 * segment]);
   Vec3 t_hat = glm::normalize(tangent);
   s.dpdu = tangent / std::max(ur.y - ur.x, 1e-8f);
-  // v runs across the width along dp/dv = n x dp/du (pbrt-v4's: its BSDF frame's second axis then
-  // points along dp/dv, which hair's offset h = -1 + 2 v assumes). Which side of the centre line a hit
-  // is on comes from the geometry; Embree's v gives only the distance from it.
-  const Vec3 p_center = center(segment, t);
-  auto v_across = [&](const Vec3& side_dir, float distance) {
-    float side = glm::dot(p - p_center, side_dir) >= 0.f ? 1.f : -1.f;
-    return 0.5f * (1.f + side * std::min(distance, 1.f));
-  };
+  // The normal of a ribbon facing the ray: -d made perpendicular to the tangent.
+  Vec3 facing = -(d - t_hat * glm::dot(d, t_hat));
+  if (!(glm::dot(facing, facing) > 0.f)) facing = Frame(t_hat).s;  // a ray along the strand: any normal to it
+  facing = glm::normalize(facing);
+  // v runs across the width from 0 to 1 towards tangent x facing, for every type: where pbrt-v4 puts
+  // it (its ray-space dp/dv, the tangent turned by +90 degrees in its left-handed ray frame). Hair's
+  // offset h = -1 + 2 v follows it, so hair highlights land on the side pbrt-v4 puts them. Which side
+  // of the centre line a hit is on comes from the geometry; Embree's v gives only the distance.
+  const Vec3 v_dir = glm::cross(t_hat, facing);
+  const float side = glm::dot(p - center(segment, t), v_dir) >= 0.f ? 1.f : -1.f;
+  auto v_at = [&](float distance) { return 0.5f * (1.f + side * std::min(distance, 1.f)); };
   if (type == CurveType::Ribbon) {
     Vec3 n = glm::normalize(embree_ng);
     // Orient as the given normals (slerped along the segment) say.
@@ -101,27 +104,20 @@ Curves::Surface Curves::surface(size_t segment, float t, float v, const Vec3& p,
     Vec3 given = q * q * q * cn[0] + 3.f * q * q * t * cn[1] + 3.f * q * t * t * cn[2] + t * t * t * cn[3];
     if (glm::dot(n, given) < 0.f) n = -n;
     s.ng = s.ns = n;
-    Vec3 side_dir = glm::normalize(glm::cross(n, t_hat));
-    s.dpdv = side_dir * w;
-    s.uv = Vec2(ur.x + t * (ur.y - ur.x), v_across(side_dir, std::abs(2.f * v - 1.f)));
+    s.dpdv = glm::normalize(glm::cross(n, t_hat)) * w;  // pbrt-v4's ribbon dp/dv
+    s.uv = Vec2(ur.x + t * (ur.y - ur.x), v_at(std::abs(2.f * v - 1.f)));
     return s;
   }
-  // Flat and cylinder: the ribbon faces the ray; its normal is -d made perpendicular to the tangent.
-  Vec3 n = -(d - t_hat * glm::dot(d, t_hat));
-  if (!(glm::dot(n, n) > 0.f)) n = Frame(t_hat).s;  // a ray along the strand: any normal to it
-  n = glm::normalize(n);
-  Vec3 side_dir = glm::cross(n, t_hat);
-  float v01 = v_across(side_dir, std::abs(v));
-  s.ng = n;
-  s.ns = n;
+  float v01 = v_at(std::abs(v));
+  s.ng = s.ns = facing;
   if (type == CurveType::Cylinder) {
     // pbrt-v4 turns the normal itself (it rotates dp/dv), so the geometric normal turns with the
     // shading one: integrators' test that the two agree on a direction's side must not cut the
     // fake tube's edges away.
     float theta = (v01 - 0.5f) * Pi;  // -90 to 90 degrees across the width, outward
-    s.ng = s.ns = glm::normalize(std::cos(theta) * n + std::sin(theta) * side_dir);
+    s.ng = s.ns = glm::normalize(std::cos(theta) * facing + std::sin(theta) * v_dir);
   }
-  s.dpdv = side_dir * w;
+  s.dpdv = v_dir * w;
   s.uv = Vec2(ur.x + t * (ur.y - ur.x), v01);
   return s;
 }
