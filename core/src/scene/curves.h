@@ -7,9 +7,10 @@
 // [i/n, (i+1)/n]); the control radii are half the width at the control points' u, which a Bezier
 // interpolates exactly because the width is linear in u. The three types, as pbrt-v4 defines them:
 //   flat      a ribbon that always faces the ray (Embree's flat curves); normal towards the ray
-//   cylinder  the same ray-facing ribbon with its normal turned from -90 to 90 degrees across its
+//   cylinder  the same ray-facing ribbon with its normal turned by -90 to 90 degrees across its
 //             width, so it shades like a tube (pbrt-v4 does the same rather than trace a tube; as
-//             there, geometric and shading normal turn together)
+//             there, geometric and shading normal turn together, and in pbrt-v4's sense: on the
+//             side facing the ray towards the far edge, docs/hair.md)
 //   ribbon    a band oriented by the normals "N" given at the segment ends (slerped between them;
 //             Embree's normal-oriented curves)
 // Embree draws a flat segment as ray-facing quads (16 per segment here, its most); on a strand bent
