@@ -54,13 +54,16 @@ Vec3 slerp(float t, const Vec3& a, const Vec3& b) {
   return glm::normalize((std::sin((1.f - t) * theta) / s) * a + (std::sin(t * theta) / s) * b);
 }
 
+// A cubic Bezier with control values c[0..3] at t (positions with radii, normals).
+template <class T>
+T bezier(const T* c, float t) {
+  float s = 1.f - t;
+  return (s * s * s) * c[0] + (3.f * s * s * t) * c[1] + (3.f * s * t * t) * c[2] + (t * t * t) * c[3];
+}
+
 }  // namespace
 
-Vec3 Curves::center(size_t segment, float t) const {
-  const Vec4* c = &control[4 * segment];
-  float s = 1.f - t;
-  return s * s * s * Vec3(c[0]) + 3.f * s * s * t * Vec3(c[1]) + 3.f * s * t * t * Vec3(c[2]) + t * t * t * Vec3(c[3]);
-}
+Vec3 Curves::center(size_t segment, float t) const { return Vec3(bezier(&control[4 * segment], t)); }
 
 Vec3 Curves::derivative(size_t segment, float t) const {
   const Vec4* c = &control[4 * segment];
@@ -68,11 +71,7 @@ Vec3 Curves::derivative(size_t segment, float t) const {
   return 3.f * (s * s * Vec3(c[1] - c[0]) + 2.f * s * t * Vec3(c[2] - c[1]) + t * t * Vec3(c[3] - c[2]));
 }
 
-float Curves::width(size_t segment, float t) const {
-  const Vec4* c = &control[4 * segment];
-  float s = 1.f - t;
-  return 2.f * (s * s * s * c[0].w + 3.f * s * s * t * c[1].w + 3.f * s * t * t * c[2].w + t * t * t * c[3].w);
-}
+float Curves::width(size_t segment, float t) const { return 2.f * bezier(&control[4 * segment], t).w; }
 
 Curves::Surface Curves::surface(size_t segment, float t, float v, const Vec3& p, const Vec3& d,
                                 const Vec3& embree_ng) const {
@@ -99,10 +98,7 @@ Curves::Surface Curves::surface(size_t segment, float t, float v, const Vec3& p,
   if (type == CurveType::Ribbon) {
     Vec3 n = glm::normalize(embree_ng);
     // Orient as the given normals (slerped along the segment) say.
-    const Vec3* cn = &normals[4 * segment];
-    float q = 1.f - t;
-    Vec3 given = q * q * q * cn[0] + 3.f * q * q * t * cn[1] + 3.f * q * t * t * cn[2] + t * t * t * cn[3];
-    if (glm::dot(n, given) < 0.f) n = -n;
+    if (glm::dot(n, bezier(&normals[4 * segment], t)) < 0.f) n = -n;
     s.ng = s.ns = n;
     s.dpdv = glm::normalize(glm::cross(n, t_hat)) * w;  // pbrt-v4's ribbon dp/dv
     s.uv = Vec2(ur.x + t * (ur.y - ur.x), v_at(std::abs(2.f * v - 1.f)));
