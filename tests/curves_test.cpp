@@ -8,6 +8,7 @@
 #include "scene/scene_builder.h"
 #include "support/command.h"
 #include "support/image_stats.h"
+#include "support/scene_errors.h"
 
 #include <gtest/gtest.h>
 
@@ -170,30 +171,29 @@ AttributeEnd
   EXPECT_FALSE(b.scene->intersect(Ray{Vec3(5, 1.2f, 5), Vec3(0, 0, -1)}));
 }
 
+// Each mistake is an error at its file, line and column (the world starts on line 2).
 TEST(Curves, BadCurvesAreLocatedErrors) {
-  std::string dir = temp_dir("curve-errors");
-  auto expect_error = [&](const std::string& world, const std::string& where, const std::string& what) {
-    std::string scene = "Camera \"perspective\"\nWorldBegin\n" + world + "\n";
-    auto r = run_penumbra({"render", write_file(dir, "scene.pbrt", scene), "-o", dir + "/o.exr", "-q"});
-    EXPECT_EQ(r.exit_code, 1) << world;
-    EXPECT_NE(r.err.find("scene.pbrt:" + where + ": error:"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+  auto expect_error = [](const std::string& world, const std::string& where, const std::string& what) {
+    std::string err = scene_build_error(world);
+    EXPECT_NE(err.find("scene.pbrt:" + where + ": error:"), std::string::npos) << err;
+    EXPECT_NE(err.find(what), std::string::npos) << err;
   };
-  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0 ]", "3:15", "needs 3k + 1 control points");
-  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0 ] \"string basis\" \"bspline\"", "3:15",
+  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0 ]", "2:15", "needs 3k + 1 control points");
+  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0 ] \"string basis\" \"bspline\"", "2:15",
                "needs at least 4 control points");
-  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"ribbon\"", "3:1",
+  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"ribbon\"", "2:1",
                "needs \"normal N\" at its 2 segment ends");
-  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"tube\"", "3:57",
+  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"tube\"", "2:57",
                "curve type 'tube' is not supported");
-  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"integer degree\" [ 4 ]", "3:57",
+  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"integer degree\" [ 4 ]", "2:57",
                "curve degree 4 is not supported");
-  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"float width\" [ -1 ]", "3:57",
+  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"float width\" [ -1 ]", "2:57",
                "width must be finite and >= 0");
-  expect_error("AreaLightSource \"diffuse\"\nShape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ]", "4:1",
+  expect_error("AreaLightSource \"diffuse\"\nShape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ]", "3:1",
                "an area light on a curve is not supported");
-  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"float alpha\" [ 0.5 ]", "3:57", "alpha");
+  expect_error("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"float alpha\" [ 0.5 ]", "2:57", "alpha");
 }
+
 // Embree ignores curve hits closer to a ray's origin than about two radii (its self-intersection
 // avoidance); the scene starts such rays further back so that a strand right next to the origin is
 // still found, as pbrt-v4 finds it. Without that, a ray from a strand to a neighbour 1.5 widths away

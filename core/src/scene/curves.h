@@ -43,8 +43,6 @@ class Curves {
   std::vector<Vec3> normals;
   /// The u range of each segment along the whole curve.
   std::vector<Vec2> u_range;
-  /// Embree's tessellation rate for flat curves (quads per segment; Embree draws at most 16).
-  int tessellation = 16;
 
   size_t segment_count() const { return u_range.size(); }
   /// Centre line and its derivative by the segment's own parameter t in [0, 1].

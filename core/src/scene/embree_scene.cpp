@@ -185,7 +185,7 @@ void EmbreeScene::add_curves(std::unique_ptr<Curves> curves, const Bsdf* bsdf, b
   auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
                                                              sizeof(uint32_t), curves->segment_count()));
   for (size_t i = 0; i < curves->segment_count(); ++i) idx[i] = static_cast<uint32_t>(4 * i);
-  rtcSetGeometryTessellationRate(geom, static_cast<float>(curves->tessellation));
+  rtcSetGeometryTessellationRate(geom, 16.f);  // quads per flat segment: Embree's most
   Geometry g;
   g.curves = curves.get();
   SurfaceOptions o = options;

@@ -38,7 +38,17 @@ class HairBsdf final : public Bsdf {
         eta_(eta),
         beta_m_(beta_m),
         beta_n_(beta_n),
-        alpha_(alpha) {}
+        alpha_(alpha) {
+    // What does not vary from hit to hit is made once: the lobes (from the roughnesses and the
+    // tilt) and the absorption.
+    TextureEvalContext none;
+    if (beta_m.is_constant() && beta_n.is_constant() && alpha.is_constant())
+      constant_lobes_ = lobes(none);
+    bool colour_constant = input == ColourInput::Melanin ? eumelanin.is_constant() && pheomelanin.is_constant()
+                                                         : colour.is_constant();
+    if (colour_constant && (input != ColourInput::Reflectance || beta_n.is_constant()))
+      constant_sigma_a_ = sigma_a(none);
+  }
 
   uint32_t flags() const override { return BsdfReflection | BsdfTransmission | BsdfGlossy; }
 
@@ -54,27 +64,33 @@ class HairBsdf final : public Bsdf {
   float pdf(const Vec3& wo, const Vec3& wi, const ShadingContext& ctx) const override { return at(ctx).pdf(wo, wi); }
 
  private:
+  float beta_n(const TextureEvalContext& t) const { return std::clamp(beta_n_.evaluate(t), 1e-3f, 1.f); }
+
+  HairLobes lobes(const TextureEvalContext& t) const {
+    return HairLobes::from(std::clamp(beta_m_.evaluate(t), 1e-3f, 1.f), beta_n(t), alpha_.evaluate(t));
+  }
+
+  Rgb sigma_a(const TextureEvalContext& t) const {
+    switch (input_) {
+      case ColourInput::SigmaA: return glm::max(colour_.evaluate(t), Rgb(0.f));
+      case ColourInput::Reflectance: return sigma_a_from_reflectance(colour_.evaluate(t), beta_n(t));
+      case ColourInput::Melanin: break;
+    }
+    return sigma_a_from_concentration(std::max(0.f, eumelanin_.evaluate(t)), std::max(0.f, pheomelanin_.evaluate(t)));
+  }
+
   HairBxdf at(const ShadingContext& ctx) const {
     const TextureEvalContext& t = ctx.tex;
-    HairParams p;
-    p.h = std::clamp(-1.f + 2.f * t.uv.y, -1.f, 1.f);
-    p.eta = eta_.evaluate(t);
-    p.beta_m = std::clamp(beta_m_.evaluate(t), 1e-3f, 1.f);
-    p.beta_n = std::clamp(beta_n_.evaluate(t), 1e-3f, 1.f);
-    p.alpha = alpha_.evaluate(t);
-    switch (input_) {
-      case ColourInput::SigmaA: p.sigma_a = glm::max(colour_.evaluate(t), Rgb(0.f)); break;
-      case ColourInput::Reflectance: p.sigma_a = sigma_a_from_reflectance(colour_.evaluate(t), p.beta_n); break;
-      case ColourInput::Melanin:
-        p.sigma_a = sigma_a_from_concentration(std::max(0.f, eumelanin_.evaluate(t)), std::max(0.f, pheomelanin_.evaluate(t)));
-        break;
-    }
-    return HairBxdf(p);
+    float h = std::clamp(-1.f + 2.f * t.uv.y, -1.f, 1.f);
+    return HairBxdf(constant_lobes_ ? *constant_lobes_ : lobes(t), h, eta_.evaluate(t),
+                    constant_sigma_a_ ? *constant_sigma_a_ : sigma_a(t));
   }
 
   ColourInput input_;
   TexturedRgb colour_;
   TexturedFloat eumelanin_, pheomelanin_, eta_, beta_m_, beta_n_, alpha_;
+  std::optional<HairLobes> constant_lobes_;
+  std::optional<Rgb> constant_sigma_a_;
 };
 
 const ParamSpec kParams[] = {

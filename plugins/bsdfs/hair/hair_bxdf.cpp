@@ -93,35 +93,39 @@ Rgb sigma_a_from_concentration(float eumelanin, float pheomelanin) {
   return eumelanin * eu + pheomelanin * pheo;
 }
 
-HairBxdf::HairBxdf(const HairParams& p) : p_(p) {
-  gamma_o_ = safe_asin(p.h);
+HairLobes HairLobes::from(float beta_m, float beta_n, float alpha) {
+  HairLobes l;
   // Longitudinal variances from beta_m (Chiang et al.'s fit), wider for the internal terms.
-  v_[0] = sqr(0.726f * p.beta_m + 0.812f * sqr(p.beta_m) + 3.7f * std::pow(p.beta_m, 20.f));
-  v_[1] = 0.25f * v_[0];
-  v_[2] = 4.f * v_[0];
-  for (int k = 3; k <= kPMax; ++k) v_[k] = v_[2];
+  l.v[0] = sqr(0.726f * beta_m + 0.812f * sqr(beta_m) + 3.7f * std::pow(beta_m, 20.f));
+  l.v[1] = 0.25f * l.v[0];
+  l.v[2] = 4.f * l.v[0];
+  for (int k = 3; k <= kPMax; ++k) l.v[k] = l.v[2];
   // Logistic scale from beta_n (sqrt(pi / 8) times the fit).
   constexpr float kSqrtPiOver8 = 0.626657069f;
-  s_ = kSqrtPiOver8 * (0.265f * p.beta_n + 1.194f * sqr(p.beta_n) + 5.372f * std::pow(p.beta_n, 22.f));
+  l.s = kSqrtPiOver8 * (0.265f * beta_n + 1.194f * sqr(beta_n) + 5.372f * std::pow(beta_n, 22.f));
   // sin and cos of 2^k alpha for the tilts of R (2 alpha), TT (alpha) and TRT (4 alpha).
-  sin2k_alpha_[0] = std::sin(p.alpha * Pi / 180.f);
-  cos2k_alpha_[0] = safe_sqrt(1.f - sqr(sin2k_alpha_[0]));
+  l.sin2k_alpha[0] = std::sin(alpha * Pi / 180.f);
+  l.cos2k_alpha[0] = safe_sqrt(1.f - sqr(l.sin2k_alpha[0]));
   for (int i = 1; i < 3; ++i) {
-    sin2k_alpha_[i] = 2.f * cos2k_alpha_[i - 1] * sin2k_alpha_[i - 1];
-    cos2k_alpha_[i] = sqr(cos2k_alpha_[i - 1]) - sqr(sin2k_alpha_[i - 1]);
+    l.sin2k_alpha[i] = 2.f * l.cos2k_alpha[i - 1] * l.sin2k_alpha[i - 1];
+    l.cos2k_alpha[i] = sqr(l.cos2k_alpha[i - 1]) - sqr(l.sin2k_alpha[i - 1]);
   }
+  return l;
 }
+
+HairBxdf::HairBxdf(const HairLobes& lobes, float h, float eta, const Rgb& sigma_a)
+    : lobes_(lobes), h_(h), eta_(eta), sigma_a_(sigma_a), gamma_o_(safe_asin(h)) {}
 
 void HairBxdf::tilt(int p, float sin_o, float cos_o, float* sin_p, float* cos_p) const {
   if (p == 0) {  // R: tilted by -2 alpha
-    *sin_p = sin_o * cos2k_alpha_[1] - cos_o * sin2k_alpha_[1];
-    *cos_p = cos_o * cos2k_alpha_[1] + sin_o * sin2k_alpha_[1];
+    *sin_p = sin_o * lobes_.cos2k_alpha[1] - cos_o * lobes_.sin2k_alpha[1];
+    *cos_p = cos_o * lobes_.cos2k_alpha[1] + sin_o * lobes_.sin2k_alpha[1];
   } else if (p == 1) {  // TT: by alpha
-    *sin_p = sin_o * cos2k_alpha_[0] + cos_o * sin2k_alpha_[0];
-    *cos_p = cos_o * cos2k_alpha_[0] - sin_o * sin2k_alpha_[0];
+    *sin_p = sin_o * lobes_.cos2k_alpha[0] + cos_o * lobes_.sin2k_alpha[0];
+    *cos_p = cos_o * lobes_.cos2k_alpha[0] - sin_o * lobes_.sin2k_alpha[0];
   } else if (p == 2) {  // TRT: by 4 alpha
-    *sin_p = sin_o * cos2k_alpha_[2] + cos_o * sin2k_alpha_[2];
-    *cos_p = cos_o * cos2k_alpha_[2] - sin_o * sin2k_alpha_[2];
+    *sin_p = sin_o * lobes_.cos2k_alpha[2] + cos_o * lobes_.sin2k_alpha[2];
+    *cos_p = cos_o * lobes_.cos2k_alpha[2] - sin_o * lobes_.sin2k_alpha[2];
   } else {
     *sin_p = sin_o;
     *cos_p = cos_o;
@@ -133,14 +137,14 @@ std::array<Rgb, kPMax + 1> HairBxdf::attenuation(float cos_theta_o) const {
   std::array<Rgb, kPMax + 1> ap;
   float sin_theta_o = safe_sqrt(1.f - sqr(cos_theta_o));
   // The refracted ray inside: its longitudinal angle, and the modified index for the azimuthal plane.
-  float sin_theta_t = sin_theta_o / p_.eta, cos_theta_t = safe_sqrt(1.f - sqr(sin_theta_t));
-  float etap = std::sqrt(std::max(sqr(p_.eta) - sqr(sin_theta_o), 1e-12f)) / std::max(cos_theta_o, 1e-6f);
-  float sin_gamma_t = p_.h / etap, cos_gamma_t = safe_sqrt(1.f - sqr(sin_gamma_t));
+  float sin_theta_t = sin_theta_o / eta_, cos_theta_t = safe_sqrt(1.f - sqr(sin_theta_t));
+  float etap = std::sqrt(std::max(sqr(eta_) - sqr(sin_theta_o), 1e-12f)) / std::max(cos_theta_o, 1e-6f);
+  float sin_gamma_t = h_ / etap, cos_gamma_t = safe_sqrt(1.f - sqr(sin_gamma_t));
   // Transmittance of one internal segment.
   Rgb T;
-  for (int k = 0; k < 3; ++k) T[k] = std::exp(-p_.sigma_a[k] * (2.f * cos_gamma_t / std::max(cos_theta_t, 1e-6f)));
-  float cos_gamma_o = safe_sqrt(1.f - sqr(p_.h));
-  float f = fresnel_dielectric(cos_theta_o * cos_gamma_o, p_.eta);
+  for (int k = 0; k < 3; ++k) T[k] = std::exp(-sigma_a_[k] * (2.f * cos_gamma_t / std::max(cos_theta_t, 1e-6f)));
+  float cos_gamma_o = safe_sqrt(1.f - sqr(h_));
+  float f = fresnel_dielectric(cos_theta_o * cos_gamma_o, eta_);
   ap[0] = Rgb(f);
   ap[1] = sqr(1.f - f) * T;
   for (int p = 2; p < kPMax; ++p) ap[p] = ap[p - 1] * T * f;
@@ -161,8 +165,8 @@ std::array<float, kPMax + 1> HairBxdf::attenuation_pdf(float cos_theta_o) const 
 }
 
 float HairBxdf::gamma_t(float sin_theta_o, float cos_theta_o) const {
-  float etap = std::sqrt(std::max(sqr(p_.eta) - sqr(sin_theta_o), 1e-12f)) / std::max(cos_theta_o, 1e-6f);
-  return safe_asin(p_.h / etap);
+  float etap = std::sqrt(std::max(sqr(eta_) - sqr(sin_theta_o), 1e-12f)) / std::max(cos_theta_o, 1e-6f);
+  return safe_asin(h_ / etap);
 }
 
 // sum_p M_p N_p weight[p] (the last term's azimuth uniform): f with A_p as weights, pdf with the
@@ -176,9 +180,9 @@ T HairBxdf::lobe_sum(const Vec3& wo, const Vec3& wi, const std::array<T, kPMax +
   for (int p = 0; p < kPMax; ++p) {
     float sin_p, cos_p;
     tilt(p, o.sin_theta, o.cos_theta, &sin_p, &cos_p);
-    sum += longitudinal(i.cos_theta, cos_p, i.sin_theta, sin_p, v_[p]) * weight[p] * azimuthal(phi, p, s_, gamma_o_, g_t);
+    sum += longitudinal(i.cos_theta, cos_p, i.sin_theta, sin_p, lobes_.v[p]) * weight[p] * azimuthal(phi, p, lobes_.s, gamma_o_, g_t);
   }
-  sum += longitudinal(i.cos_theta, o.cos_theta, i.sin_theta, o.sin_theta, v_[kPMax]) * weight[kPMax] / (2.f * Pi);
+  sum += longitudinal(i.cos_theta, o.cos_theta, i.sin_theta, o.sin_theta, lobes_.v[kPMax]) * weight[kPMax] / (2.f * Pi);
   return sum;
 }
 
@@ -207,7 +211,7 @@ std::optional<HairSample> HairBxdf::sample_f(const Vec3& wo, float uc, Vec2 u) c
   float sin_p, cos_p;
   tilt(p, o.sin_theta, o.cos_theta, &sin_p, &cos_p);
   // theta_i from M_p (d'Eon et al.'s sampling of the longitudinal lobe).
-  float v = v_[p];
+  float v = lobes_.v[p];
   float cos_theta = 1.f + v * std::log(std::max(u[0], 1e-5f) + (1.f - u[0]) * std::exp(-2.f / v));
   float sin_theta = safe_sqrt(1.f - sqr(cos_theta));
   float cos_phi = std::cos(2.f * Pi * u[1]);
@@ -215,7 +219,7 @@ std::optional<HairSample> HairBxdf::sample_f(const Vec3& wo, float uc, Vec2 u) c
   float cos_theta_i = safe_sqrt(1.f - sqr(sin_theta_i));
   // phi_i from N_p.
   float dphi = p < kPMax ? exit_azimuth(p, gamma_o_, gamma_t(o.sin_theta, o.cos_theta)) +
-                               sample_trimmed_logistic(uc, s_, -Pi, Pi)
+                               sample_trimmed_logistic(uc, lobes_.s, -Pi, Pi)
                          : 2.f * Pi * uc;
   float phi_i = o.phi + dphi;
   Vec3 wi(sin_theta_i, cos_theta_i * std::cos(phi_i), cos_theta_i * std::sin(phi_i));

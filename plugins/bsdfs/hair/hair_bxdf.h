@@ -28,13 +28,14 @@ namespace penumbra::hair {
 
 constexpr int kPMax = 3;
 
-struct HairParams {
-  float h = 0.f;       // offset across the fibre, [-1, 1]
-  float eta = 1.55f;   // index of refraction of the fibre
-  Rgb sigma_a{0.f};    // absorption per fibre diameter
-  float beta_m = 0.3f; // longitudinal roughness, (0, 1]
-  float beta_n = 0.3f; // azimuthal roughness, (0, 1]
-  float alpha = 2.f;   // cuticle scale tilt, degrees
+/// What the roughnesses and the cuticle tilt make of the lobes: the same at every hit of a material
+/// whose beta_m, beta_n and alpha are constant, so it is made once for such a material.
+struct HairLobes {
+  std::array<float, kPMax + 1> v{};     // longitudinal variances of the terms
+  float s = 0.f;                        // scale of the azimuthal logistic
+  std::array<float, 3> sin2k_alpha{}, cos2k_alpha{};  // the tilt 2^k alpha, k = 0, 1, 2
+  /// beta_m, beta_n in (0, 1]; alpha in degrees.
+  static HairLobes from(float beta_m, float beta_n, float alpha);
 };
 
 /// Absorption of a fibre whose multiple scattering looks like colour `c` (pbrt-v4's fit to
@@ -51,7 +52,9 @@ struct HairSample {
 
 class HairBxdf {
  public:
-  explicit HairBxdf(const HairParams& p);
+  /// The fibre at a hit: offset h in [-1, 1] across it, index of refraction eta, absorption sigma_a
+  /// per fibre diameter.
+  HairBxdf(const HairLobes& lobes, float h, float eta, const Rgb& sigma_a);
   Rgb f(const Vec3& wo, const Vec3& wi) const;
   std::optional<HairSample> sample_f(const Vec3& wo, float uc, Vec2 u) const;
   float pdf(const Vec3& wo, const Vec3& wi) const;
@@ -67,11 +70,10 @@ class HairBxdf {
   template <class T>
   T lobe_sum(const Vec3& wo, const Vec3& wi, const std::array<T, kPMax + 1>& weight) const;
 
-  HairParams p_;
+  HairLobes lobes_;
+  float h_, eta_;
+  Rgb sigma_a_;
   float gamma_o_;
-  std::array<float, kPMax + 1> v_;
-  float s_;
-  std::array<float, 3> sin2k_alpha_, cos2k_alpha_;
 };
 
 }  // namespace penumbra::hair
