@@ -54,6 +54,7 @@ Vertex surface_vertex(const SurfaceInteraction& si, const Rgb& beta, TransportMo
   v.shading = si.shading;
   v.tex = si.texture_context();
   v.wo = si.wo;
+  v.wo_local = si.shading.to_local(si.wo);
   v.bsdf = si.bsdf;
   v.surface_connectible = si.bsdf && si.bsdf->flags() != 0 && !si.bsdf->is_specular_only();
   v.light = si.area_light;
@@ -78,9 +79,9 @@ void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vec3& wa, const 
   *to_a = convert_density(cur.bsdf->pdf(wb, wa, sc), cur, a);
 }
 
-void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vertex& b, float* to_b, float* to_a) {
-  surface_pdf_pair(cur, a, cur.shading.to_local(direction_to(cur, a)), b, cur.shading.to_local(direction_to(cur, b)),
-                   to_b, to_a);
+// The same for `prev`, the vertex's own predecessor on its subpath, whose local direction it keeps.
+void surface_pdf_pair_from_prev(const Vertex& cur, const Vertex& prev, const Vertex& b, float* to_b, float* to_prev) {
+  surface_pdf_pair(cur, prev, cur.w_prev_local, b, cur.shading.to_local(direction_to(cur, b)), to_b, to_prev);
 }
 
 // Extends path[0 .. n-1] (n >= 1, path[n-1] the start point) by at most `max_vertices` scattering
@@ -114,6 +115,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     if (si) {
       v = surface_vertex(*si, beta, mode);
       v.medium = static_cast<int16_t>(medium);
+      v.w_prev_local = v.shading.to_local(direction_to(v, prev));
     } else if (mode == TransportMode::Radiance && !scene.infinite_lights().empty()) {
       // Camera rays that escape may see environment lights: keep them as an endpoint at infinity.
       v = Vertex{};
@@ -128,7 +130,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     if (!prev.delta) {
       if (before && prev.kind == VertexKind::Surface) {
         // Both densities at prev from one pair of directions (the same values as pdf_area's).
-        surface_pdf_pair(prev, *before, v, &v.pdf_fwd, &before->pdf_rev);
+        surface_pdf_pair_from_prev(prev, *before, v, &v.pdf_fwd, &before->pdf_rev);
       } else {
         v.pdf_fwd = pdf_area(ctx, before, prev, v);  // solid angle for a vertex at infinity
         if (before) before->pdf_rev = pdf_area(ctx, &v, prev, *before);
@@ -153,7 +155,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
 
     const Bsdf& bsdf = *v.bsdf;
     ShadingContext sctx{v.tex, mode};
-    Vec3 wo = v.shading.to_local(v.wo);
+    const Vec3& wo = v.wo_local;
     std::optional<BsdfSample> bs = bsdf.flags() ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
     if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
     Vec3 wi = v.shading.to_world(bs->wi);
@@ -209,7 +211,7 @@ Rgb Vertex::f(const Vertex& next) const {
   if (kind != VertexKind::Surface) return Rgb(0.f);
   Vec3 wi = direction_to(*this, next);
   if (leaks(*this, wo, wi)) return Rgb(0.f);
-  Rgb value = bsdf->f(shading.to_local(wo), shading.to_local(wi), ShadingContext{tex, mode});
+  Rgb value = bsdf->f(wo_local, shading.to_local(wi), ShadingContext{tex, mode});
   if (mode == TransportMode::Importance) value *= shading_correction(*this, wo, wi);
   return value;
 }
@@ -458,7 +460,7 @@ double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex*
 // Vertex::f() towards world direction wi (local wi_local), wi = direction_to(v, next).
 Rgb surface_f(const Vertex& v, const Vec3& wi, const Vec3& wi_local) {
   if (leaks(v, v.wo, wi)) return Rgb(0.f);
-  Rgb value = v.bsdf->f(v.shading.to_local(v.wo), wi_local, ShadingContext{v.tex, v.mode});
+  Rgb value = v.bsdf->f(v.wo_local, wi_local, ShadingContext{v.tex, v.mode});
   if (v.mode == TransportMode::Importance) value *= shading_correction(v, v.wo, wi);
   return value;
 }
@@ -471,27 +473,24 @@ Rgb connect_surfaces(const Context& ctx, const Vertex* light, int s, const Verte
   const Vertex& pt = camera[t - 1];
   if (!qs.connectible() || !pt.connectible() || pt.kind != VertexKind::Surface) return Rgb(0.f);
   // qs (s >= 2) and pt are surface vertices.
-  Vec3 w = direction_to(qs, pt);  // qs -> pt; direction_to(pt, qs) is exactly -w
-  Vec3 wq = qs.shading.to_local(w), wp = pt.shading.to_local(-w);
-  Rgb L = qs.beta * surface_f(qs, w, wq) * surface_f(pt, -w, wp) * pt.beta;
-  if (is_black(L)) return L;
   Vec3 d = pt.p - qs.p;
   float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.f)) return Rgb(0.f);
-  Vec3 wn = d / std::sqrt(dist2);
-  L *= std::abs(glm::dot(qs.ns, wn)) * std::abs(glm::dot(pt.ns, wn)) / dist2;
-  if (ctx.scene.has_media())
-    L *= ctx.scene.segment_transmittance(medium_side(qs, wn), medium_side(pt, -wn), std::sqrt(dist2));
+  float dist = std::sqrt(dist2);
+  Vec3 w = d / dist;  // qs -> pt
+  Vec3 wq = qs.shading.to_local(w), wp = pt.shading.to_local(-w);
+  Rgb L = qs.beta * surface_f(qs, w, wq) * surface_f(pt, -w, wp) * pt.beta;
+  if (is_black(L)) return L;
+  L *= std::abs(glm::dot(qs.ns, w)) * std::abs(glm::dot(pt.ns, w)) / dist2;
+  if (ctx.scene.has_media()) L *= ctx.scene.segment_transmittance(medium_side(qs, w), medium_side(pt, -w), dist);
   if (is_black(L) ||
       ctx.scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng)))
     return Rgb(0.f);
   if (patch) {
     const Vertex& qs_prev = light[s - 2];
     const Vertex& pt_prev = camera[t - 2];
-    surface_pdf_pair(qs, qs_prev, qs.shading.to_local(direction_to(qs, qs_prev)), pt, wq, &patch->light_s,
-                     &patch->camera_s2);
-    surface_pdf_pair(pt, qs, wp, pt_prev, pt.shading.to_local(direction_to(pt, pt_prev)), &patch->light_s1,
-                     &patch->camera_s1);
+    surface_pdf_pair(qs, qs_prev, qs.w_prev_local, pt, wq, &patch->light_s, &patch->camera_s2);
+    surface_pdf_pair(pt, qs, wp, pt_prev, pt.w_prev_local, &patch->light_s1, &patch->camera_s1);
     patch->nee_ratio = s + t - 1 >= 2 ? cached_nee_ratio(light, s, nullptr, light[0], light[1]) : 1.0;
   }
   return L;
@@ -596,7 +595,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     // s >= 2: qs is a surface vertex with a predecessor. The lens density towards qs is the one
     // pdf_we() just gave for the direction lens -> qs.
     Patch patch;
-    surface_pdf_pair(qs, light[s - 2], cam, &patch.light_s, &patch.camera_s2);
+    surface_pdf_pair_from_prev(qs, light[s - 2], cam, &patch.light_s, &patch.camera_s2);
     patch.camera_s1 = convert_density(pdf_dir, cam, qs);
     patch.nee_ratio = cached_nee_ratio(light, s, nullptr, light[0], light[1]);
     c.weight = weight_with(ctx, light, s, camera, t, nullptr, &cam, Technique::Regular, patch);
@@ -654,8 +653,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     Patch patch;
     patch.light_s = to_pt;
     patch.light_0 = lv.pdf_fwd;
-    surface_pdf_pair(pt, lv, wl, camera[t - 2], pt.shading.to_local(direction_to(pt, camera[t - 2])), &patch.light_s1,
-                     &patch.camera_s1);
+    surface_pdf_pair(pt, lv, wl, camera[t - 2], pt.w_prev_local, &patch.light_s1, &patch.camera_s1);
     // sample_li() drew lv with the density next_event_ratio() asks pdf_li() for.
     patch.nee_ratio = next_event_ratio_applies(lv, pt) ? next_event_ratio_from(lv, pt, ls->pdf, pdf_pos) : 1.0;
     c.weight = weight_with(ctx, light, s, camera, t, &lv, nullptr, Technique::Regular, patch);

@@ -63,6 +63,10 @@ struct Vertex {
   Frame shading;
   TextureEvalContext tex;  // surfaces: where textured materials are evaluated (tex.uv: the uv)
   Vec3 wo{0.f};           // surfaces: unit direction towards the previous vertex of the subpath
+  Vec3 wo_local{0.f};     // surfaces: wo in the shading frame (every f() and the sampling need it)
+  // Surfaces: unit direction towards the previous vertex from their positions, in the shading frame:
+  // what the densities use (see random_walk), made once instead of at every connection.
+  Vec3 w_prev_local{0.f};
   Vec3 w_light{0.f};      // vertices at infinity (environment, distant light): direction light travels
   const Bsdf* bsdf = nullptr;
   const Light* light = nullptr;  // light endpoints, and surfaces that emit
