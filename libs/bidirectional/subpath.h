@@ -207,7 +207,7 @@ struct Connection {
   bool has_sampled = false;
   // The endpoint drawn for s = 1 (light) or t = 1 (camera), valid only when has_sampled. Left
   // uninitialised otherwise: connect() runs about ten times per sample and most calls draw none,
-  // and zeroing a 168-byte vertex each time was a visible part of its cost.
+  // and zeroing a vertex (264 bytes) each time was a visible part of its cost.
   union {
     Vertex sampled;
   };
