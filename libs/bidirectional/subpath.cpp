@@ -301,6 +301,51 @@ double next_event_ratio(const Vertex& x0, const Vertex& x1) {
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+double remap_density(double p) { return p != 0.0 ? p : 1.0; }  // deltas count as 1 (mis.h)
+
+// (p_i / p_{i+1})^beta for the strategies either side of `v` on its subpath: moving v to the other
+// side replaces its own side's density by the other side's (mis.h's recurrence, both subpaths).
+double moved_ratio(const Vertex& v, MisHeuristic h) {
+  return mis_power(remap_density(v.pdf_rev) / remap_density(v.pdf_fwd), h);
+}
+
+bool light_hittable(const Vertex& x0) { return x0.light && !is_delta_light(x0.light->type()); }
+
+// Vertex::mis_sum along a traced light subpath: G_j = rho_j (poss_j w_j + G_{j-1}), where strategy j
+// (light vertices 0..j-1) is possible when neither x_{j-1} nor x_j is specular (strategy 0: when
+// camera paths can hit the light), and w_1 is the next-event correction (mis.h).
+void fold_light_sums(const Context& ctx, Vertex* path, int n) {
+  MisHeuristic h = ctx.config.heuristic;
+  double nee_w = 1.0;
+  if (n >= 2) {
+    double nee = std::isnan(path[0].nee_ratio) ? next_event_ratio(path[0], path[1]) : path[0].nee_ratio;
+    nee_w = mis_power(nee, h);
+  }
+  double g = 0.0;
+  for (int j = 0; j < n; ++j) {
+    bool possible = j == 0 ? light_hittable(path[0]) : !path[j - 1].delta && !path[j].delta;
+    g = moved_ratio(path[j], h) * ((possible ? (j == 1 ? nee_w : 1.0) : 0.0) + g);
+    path[j].mis_sum = g;
+  }
+}
+
+// The same along a camera subpath: H_j = rho_j (poss_j + H_{j-1}), H_0 = 0 (the lens never moves:
+// there is no t = 0 strategy).
+void fold_camera_sums(const Context& ctx, Vertex* path, int n) {
+  MisHeuristic h = ctx.config.heuristic;
+  double sum = 0.0;
+  path[0].mis_sum = 0.0;
+  for (int j = 1; j < n; ++j) {
+    bool possible = !path[j].delta && !path[j - 1].delta;
+    sum = moved_ratio(path[j], h) * ((possible ? 1.0 : 0.0) + sum);
+    path[j].mis_sum = sum;
+  }
+}
+
+}  // namespace
+
 int camera_subpath(const Context& ctx, const Ray& ray, PathSampler& ps, Vertex* path) {
   Vertex& cam = path[0];
   cam = Vertex{};
@@ -312,7 +357,9 @@ int camera_subpath(const Context& ctx, const Ray& ray, PathSampler& ps, Vertex* 
   cam.delta = !ctx.scene.camera().connectible();
   float pdf_dir;
   ctx.scene.camera().pdf_we(ray, &cam.pdf_fwd, &pdf_dir);
-  return 1 + random_walk(ctx, ray, ps, Rgb(1.f), TransportMode::Radiance, path, ctx.config.max_depth + 1);
+  int n = 1 + random_walk(ctx, ray, ps, Rgb(1.f), TransportMode::Radiance, path, ctx.config.max_depth + 1);
+  fold_camera_sums(ctx, path, n);
+  return n;
 }
 
 int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
@@ -341,6 +388,7 @@ int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
   y0.pdf_fwd = pdf_light_origin(ctx, y0, n > 0 ? path[1] : y0);
   // The same for every connection with s >= 2 (x_0 and x_1 are this path's): once per path.
   if (ctx.config.store_nee_ratio) y0.nee_ratio = n > 0 ? static_cast<float>(next_event_ratio(y0, path[1])) : 1.f;
+  if (ctx.config.store_nee_ratio) fold_light_sums(ctx, path, n + 1);
   return n + 1;
 }
 
@@ -389,9 +437,58 @@ double cached_nee_ratio(const Vertex* light, int s, const Vertex* light_end, con
   return next_event_ratio(x0, x1);
 }
 
+// The weight of strategy (s, t) when every technique is a per-sample one, in O(1): the densities
+// the connection changes (`patch`) for the two vertices on each side of the new edge, and the
+// subpaths' folded sums (Vertex::mis_sum) beyond them. The same sum as strategy_density_ratios() and
+// mis_weight_from_ratios() make from the whole path, term by term.
+double regular_weight(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
+                      const Vertex* light_end, const Vertex* camera_end, const Patch& patch) {
+  const MisHeuristic h = ctx.config.heuristic;
+  auto L = [&](int i) -> const Vertex& { return (i == s - 1 && light_end) ? *light_end : light[i]; };
+  auto C = [&](int j) -> const Vertex& { return (j == t - 1 && camera_end) ? *camera_end : camera[j]; };
+  const double nee_w = mis_power(patch.nee_ratio, h);  // the correction of strategy 1 (k >= 2 here)
+
+  // Strategies 0 .. s-1: x_{s-1} (connected, so not specular) and x_{s-2} see new neighbours.
+  double light_sum = 0.0;
+  if (s == 1) {
+    double rho = mis_power(remap_density(patch.camera_s1) / remap_density(patch.light_0), h);
+    light_sum = light_hittable(L(0)) ? rho : 0.0;
+  } else if (s >= 2) {
+    const Vertex& end = L(s - 1);
+    const Vertex& before = L(s - 2);
+    double rho_end = mis_power(remap_density(patch.camera_s1) / remap_density(end.pdf_fwd), h);
+    double rho_before = mis_power(remap_density(patch.camera_s2) / remap_density(before.pdf_fwd), h);
+    double w_end = before.delta ? 0.0 : (s == 2 ? nee_w : 1.0);
+    bool before_possible = s == 2 ? light_hittable(L(0)) : !L(s - 3).delta && !before.delta;
+    double w_before = before_possible ? (s == 3 ? nee_w : 1.0) : 0.0;
+    double beyond = s >= 3 ? L(s - 3).mis_sum : 0.0;
+    light_sum = rho_end * (w_end + rho_before * (w_before + beyond));
+  }
+  // Strategies s+1 .. k: x_s (connected) and x_{s+1} see new neighbours.
+  double camera_sum = 0.0;
+  if (t >= 2) {
+    const Vertex& end = C(t - 1);
+    const Vertex& before = C(t - 2);
+    double rho_end = mis_power(remap_density(patch.light_s) / remap_density(end.pdf_fwd), h);
+    double inner = before.delta ? 0.0 : (s == 0 ? nee_w : 1.0);
+    if (t >= 3) {
+      double rho_before = mis_power(remap_density(patch.light_s1) / remap_density(before.pdf_fwd), h);
+      const Vertex& beyond = C(t - 3);
+      inner += rho_before * ((!before.delta && !beyond.delta ? 1.0 : 0.0) + beyond.mis_sum);
+    }
+    camera_sum = rho_end * inner;
+  }
+  // Strategy 1 samples x_0 by next-event estimation: every other strategy's ratio is over its density.
+  double sum = 1.0 + (s == 1 ? (light_sum + camera_sum) / nee_w : light_sum + camera_sum);
+  if (!(sum > 0.0) || !std::isfinite(sum)) return std::isinf(sum) ? 0.0 : 1.0;
+  return 1.0 / sum;
+}
+
 double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex* camera, int t,
                    const Vertex* light_end, const Vertex* camera_end, Technique tau, const Patch& patch) {
   if (s + t == 2) return 1.0;
+  if (!ctx.techniques || ctx.techniques->all_regular())
+    return regular_weight(ctx, light, s, camera, t, light_end, camera_end, patch);
   int k = s + t - 1;
   auto L = [&](int i) -> const Vertex& { return (i == s - 1 && light_end) ? *light_end : light[i]; };
   auto C = [&](int j) -> const Vertex& { return (j == t - 1 && camera_end) ? *camera_end : camera[j]; };
@@ -424,7 +521,6 @@ double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex*
   path.light_hittable = x0.light && !is_delta_light(x0.light->type());
   path.nee_ratio = k >= 2 ? patch.nee_ratio : 1.0;
   strategy_density_ratios(path, s, ratios);
-  if (!ctx.techniques || ctx.techniques->all_regular()) return mis_weight_from_ratios(ratios, s, ctx.config.heuristic);
 
   // Several techniques per strategy: strategy i's sum is sum_tau c_tau(i)^beta (mis.h).
   const TechniqueSet& ts = *ctx.techniques;

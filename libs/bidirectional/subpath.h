@@ -12,6 +12,13 @@
 // before its partner is known. The cost is O(path length) per connection, which is small next to
 // the shadow ray it comes with.
 //
+// Where every technique is a per-sample one (no cache: plain bdpt and light tracing), the weights do
+// not walk the path. Once a subpath is traced, each vertex stores the sum over the strategies that
+// move it and the vertices before it to the other side (Vertex::mis_sum, the ratio recurrence of
+// mis.h folded from the subpath's start, the partial sums of VCM); a connection then changes only its
+// two vertices on each side and reads the stored sum beyond them, in O(1). tests/bdpt_test.cpp checks
+// both forms against brute force on real paths.
+//
 // Russian roulette is kept out of the MIS densities: the reverse density would need the roulette
 // probability the *other* subpath would have used, which depends on a throughput that does not
 // exist. Weights computed without it are still a partition of unity over the strategies that can
@@ -82,6 +89,12 @@ struct Vertex {
   // connection with s >= 2 light vertices needs for its MIS weight (NaN: not known, computed when
   // needed). Fits in the padding after `mode`.
   float nee_ratio = std::numeric_limits<float>::quiet_NaN();
+  // Sum over the strategies that move this vertex and every vertex between it and its subpath's
+  // start to the other side, of (p_i / p_s)^beta with p_s the strategy that connects just beyond it
+  // (0 for the lens and where nothing can move): set by camera_subpath() and light_subpath() for the
+  // O(1) weights (see the top of this file); valid for every connection that changes neither this
+  // vertex nor those before it.
+  double mis_sum = 0.0;
 
   bool on_surface() const { return ng != Vec3(0.f); }
   /// Whether a deterministic connection can end here (it needs a non-delta scattering or emission).
@@ -207,7 +220,7 @@ struct Connection {
   bool has_sampled = false;
   // The endpoint drawn for s = 1 (light) or t = 1 (camera), valid only when has_sampled. Left
   // uninitialised otherwise: connect() runs about ten times per sample and most calls draw none,
-  // and zeroing a vertex (264 bytes) each time was a visible part of its cost.
+  // and zeroing a vertex (272 bytes) each time was a visible part of its cost.
   union {
     Vertex sampled;
   };
