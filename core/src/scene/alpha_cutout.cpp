@@ -42,19 +42,12 @@ uint64_t hit_salt(unsigned geom, unsigned prim, float t) {
 namespace {
 
 // The hit's lookup context (no footprint: pbrt-v4 tests alpha before differentials exist).
-TextureEvalContext hit_context(const GeometryUserData& g, const Vec3& o, const Vec3& d, float t, float u, float v,
-                               unsigned prim) {
+TextureEvalContext hit_context(const GeometryUserData& g, float u, float v, unsigned prim) {
   TextureEvalContext ctx;
-  if (g.mesh) {
-    Vec3 b(1.f - u - v, u, v);
-    ctx.p = g.mesh->position(prim, b);
-    ctx.n = g.mesh->geometric_normal(prim, b);
-    ctx.uv = g.mesh->uv_at(prim, b);
-  } else {
-    ctx.p = g.sphere->reproject(o + t * d);
-    ctx.n = g.sphere->normal_at(ctx.p);
-    ctx.uv = g.sphere->uv_at(ctx.p);
-  }
+  Vec3 b(1.f - u - v, u, v);
+  ctx.p = g.mesh->position(prim, b);
+  ctx.n = g.mesh->geometric_normal(prim, b);
+  ctx.uv = g.mesh->uv_at(prim, b);
   return ctx;
 }
 
@@ -70,7 +63,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     Vec3 d(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i));
     float t = RTCRayN_tfar(ray, N, i);
     unsigned prim = RTCHitN_primID(hit, N, i), geom = RTCHitN_geomID(hit, N, i);
-    TextureEvalContext ctx = hit_context(*g, o, d, t, RTCHitN_u(hit, N, i), RTCHitN_v(hit, N, i), prim);
+    TextureEvalContext ctx = hit_context(*g, RTCHitN_u(hit, N, i), RTCHitN_v(hit, N, i), prim);
     if (!g->cutout.keeps(ctx, o, d, hit_salt(geom, prim, t))) args->valid[i] = 0;
   }
 }
@@ -83,13 +76,19 @@ void set_alpha_filters(RTCGeometry geom, const GeometryUserData* data) {
   rtcSetGeometryOccludedFilterFunction(geom, alpha_filter<true>);
 }
 
-bool quadric_hit_kept(const GeometryUserData& data, const Ray& ray, float t, uint64_t salt) {
+bool user_hit_kept(const GeometryUserData& data, const Ray& ray, float t, uint64_t salt) {
   if (!data.cutout.active()) return true;
-  Quadric::Surface s = data.quadric->surface_at(ray, t);
   TextureEvalContext ctx;
-  ctx.p = s.p;
-  ctx.n = s.n;
-  ctx.uv = s.uv;
+  if (data.quadric) {
+    Quadric::Surface s = data.quadric->surface_at(ray, t);
+    ctx.p = s.p;
+    ctx.n = s.n;
+    ctx.uv = s.uv;
+  } else {
+    ctx.p = data.sphere->reproject(ray.o + t * ray.d);
+    ctx.n = data.sphere->normal_at(ctx.p);
+    ctx.uv = data.sphere->uv_at(ctx.p);
+  }
   return data.cutout.keeps(ctx, ray.o, ray.d, salt);
 }
 

@@ -38,7 +38,7 @@ struct GeometryUserData {
   AlphaCutout cutout;
 };
 
-/// Installs the intersection and occlusion filters of a triangle mesh or sphere geometry whose
+/// Installs the intersection and occlusion filters of a triangle mesh geometry whose
 /// `data` has an active cut-out (data must outlive the scene).
 void set_alpha_filters(RTCGeometry geom, const GeometryUserData* data);
 
@@ -46,7 +46,7 @@ void set_alpha_filters(RTCGeometry geom, const GeometryUserData* data);
 /// hit twice along a ray, and each layer decides on its own, as pbrt-v4's re-traced rays do).
 uint64_t hit_salt(unsigned geom, unsigned prim, float t);
 
-/// For user geometry: whether the quadric's hit at t of the ray counts (`salt`: hit_salt()).
-bool quadric_hit_kept(const GeometryUserData& data, const Ray& ray, float t, uint64_t salt);
+/// For user geometry (a sphere or a quadric): whether its hit at t of the ray counts (`salt`: hit_salt()).
+bool user_hit_kept(const GeometryUserData& data, const Ray& ray, float t, uint64_t salt);
 
 }  // namespace penumbra

@@ -82,44 +82,32 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
   meshes_.push_back(std::move(mesh));
 }
 
-void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured,
-                             MediumInterface media, const SurfaceOptions& options) {
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                        RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
-  Vec3 c = sphere->center();
-  v[0] = c.x, v[1] = c.y, v[2] = c.z, v[3] = sphere->radius();
-  target_bounds().extend(c - Vec3(sphere->radius()));
-  target_bounds().extend(c + Vec3(sphere->radius()));
-  if (options.cutout.active()) set_alpha_filters(geom, keep_user_data({nullptr, sphere.get(), nullptr, options.cutout}));
-  Geometry g;
-  g.sphere = sphere.get();
-  if (light) g.lights.push_back(light);
-  attach(geom, std::move(g), bsdf, textured, media, options);
-  spheres_.push_back(std::move(sphere));
-}
-
-// User-geometry callbacks for disks and cylinders (one primitive per geometry; rays come one at a
-// time from rtcIntersect1/rtcOccluded1).
-static void quadric_bounds(const RTCBoundsFunctionArguments* args) {
-  Bounds3 b = static_cast<const GeometryUserData*>(args->geometryUserPtr)->quadric->world_bounds();
+// User-geometry callbacks for spheres, disks and cylinders (one primitive per geometry; rays come one
+// at a time from rtcIntersect1/rtcOccluded1). Embree's native sphere primitive (RTC_GEOMETRY_TYPE_
+// SPHERE_POINT) cost about 400 instructions per ray on a scene of two spheres and ten triangles, as much
+// as the whole triangle BVH; the analytic test here costs a fraction of that (docs/benchmarks.md).
+static void user_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto* data = static_cast<const GeometryUserData*>(args->geometryUserPtr);
+  Bounds3 b = data->quadric ? data->quadric->world_bounds()
+                            : Bounds3{data->sphere->center() - Vec3(data->sphere->radius()),
+                                      data->sphere->center() + Vec3(data->sphere->radius())};
   RTCBounds* out = args->bounds_o;
   out->lower_x = b.min.x, out->lower_y = b.min.y, out->lower_z = b.min.z;
   out->upper_x = b.max.x, out->upper_y = b.max.y, out->upper_z = b.max.z;
 }
 
-// The first hit in (t_min, t_max) that the cut-out keeps (a cylinder has two along a ray).
+// The first hit in (t_min, t_max) that the cut-out keeps (a sphere or a cylinder has two along a ray).
 static std::optional<float> first_kept_hit(const GeometryUserData& data, const Ray& ray, float t_min, float t_max,
                                            unsigned geom_id) {
   for (int k = 0; k < 4; ++k) {
-    auto t = data.quadric->intersect(ray, t_min, t_max);
-    if (!t || quadric_hit_kept(data, ray, *t, hit_salt(geom_id, 0, *t))) return t;
+    auto t = data.quadric ? data.quadric->intersect(ray, t_min, t_max) : data.sphere->intersect(ray, t_min, t_max);
+    if (!t || !data.cutout.active() || user_hit_kept(data, ray, *t, hit_salt(geom_id, 0, *t))) return t;
     t_min = *t;
   }
   return std::nullopt;
 }
 
-static void quadric_intersect(const RTCIntersectFunctionNArguments* args) {
+static void user_intersect(const RTCIntersectFunctionNArguments* args) {
   if (args->N != 1 || !args->valid[0]) return;
   auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
   Ray ray{Vec3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z), Vec3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z)};
@@ -134,7 +122,7 @@ static void quadric_intersect(const RTCIntersectFunctionNArguments* args) {
   rh->hit.instID[0] = args->context->instID[0];
 }
 
-static void quadric_occluded(const RTCOccludedFunctionNArguments* args) {
+static void user_occluded(const RTCOccludedFunctionNArguments* args) {
   if (args->N != 1 || !args->valid[0]) return;
   auto* r = reinterpret_cast<RTCRay*>(args->ray);
   Ray ray{Vec3(r->org_x, r->org_y, r->org_z), Vec3(r->dir_x, r->dir_y, r->dir_z)};
@@ -142,14 +130,32 @@ static void quadric_occluded(const RTCOccludedFunctionNArguments* args) {
     r->tfar = -INFINITY;
 }
 
-void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light,
-                              bool textured, MediumInterface media, const SurfaceOptions& options) {
+RTCGeometry EmbreeScene::new_user_geometry(const GeometryUserData& data) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(geom, 1);
-  rtcSetGeometryUserData(geom, const_cast<GeometryUserData*>(keep_user_data({nullptr, nullptr, quadric.get(), options.cutout})));
-  rtcSetGeometryBoundsFunction(geom, quadric_bounds, nullptr);
-  rtcSetGeometryIntersectFunction(geom, quadric_intersect);
-  rtcSetGeometryOccludedFunction(geom, quadric_occluded);
+  rtcSetGeometryUserData(geom, const_cast<GeometryUserData*>(keep_user_data(data)));
+  rtcSetGeometryBoundsFunction(geom, user_bounds, nullptr);
+  rtcSetGeometryIntersectFunction(geom, user_intersect);
+  rtcSetGeometryOccludedFunction(geom, user_occluded);
+  return geom;
+}
+
+void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, const Light* light, bool textured,
+                             MediumInterface media, const SurfaceOptions& options) {
+  RTCGeometry geom = new_user_geometry({nullptr, sphere.get(), nullptr, options.cutout});
+  Vec3 c = sphere->center();
+  target_bounds().extend(c - Vec3(sphere->radius()));
+  target_bounds().extend(c + Vec3(sphere->radius()));
+  Geometry g;
+  g.sphere = sphere.get();
+  if (light) g.lights.push_back(light);
+  attach(geom, std::move(g), bsdf, textured, media, options);
+  spheres_.push_back(std::move(sphere));
+}
+
+void EmbreeScene::add_quadric(std::unique_ptr<Quadric> quadric, const Bsdf* bsdf, const Light* light,
+                              bool textured, MediumInterface media, const SurfaceOptions& options) {
+  RTCGeometry geom = new_user_geometry({nullptr, nullptr, quadric.get(), options.cutout});
   Bounds3 b = quadric->world_bounds();
   target_bounds().extend(b.min);
   target_bounds().extend(b.max);
@@ -262,6 +268,7 @@ size_t EmbreeScene::triangle_count() const {
 
 std::optional<SampledLight> EmbreeScene::sample_light(float u) const {
   if (lights_.empty()) return std::nullopt;
+  if (lights_.size() == 1) return SampledLight{lights_[0], 1.f};  // what the distribution gives, without the search
   float pmf = 0.f;
   size_t i = light_distribution_.sample_discrete(u, &pmf);
   if (pmf == 0.f) return std::nullopt;

@@ -1,4 +1,4 @@
-// The renderable scene: Embree 3 geometry (triangle meshes, native sphere points, and disks and
+// The renderable scene: Embree 3 geometry (triangle meshes and curves, and spheres, disks and
 // cylinders as user geometry with analytic intersection) plus what a hit
 // needs to become a SurfaceInteraction (material, area lights, orientation).
 #pragma once
@@ -122,6 +122,8 @@ class EmbreeScene final : public Scene {
               const SurfaceOptions& options);
   void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;
   const GeometryUserData* keep_user_data(GeometryUserData data);
+  /// An Embree user geometry of one analytic primitive (a sphere or a quadric in `data`).
+  RTCGeometry new_user_geometry(const GeometryUserData& data);
   static ShadingGeometry shading_geometry(const Geometry& g, const SurfaceInteraction& si, const Vec3& dpdu,
                                           const Vec3& dpdv);
 

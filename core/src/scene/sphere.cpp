@@ -16,6 +16,27 @@ Vec3 Sphere::normal_at(const Vec3& p) const {
   return inward_ ? -n : n;
 }
 
+std::optional<float> Sphere::intersect(const Ray& ray, float t_min, float t_max) const {
+  glm::dvec3 oc = glm::dvec3(ray.o) - glm::dvec3(center_);
+  glm::dvec3 d(ray.d);
+  double a = glm::dot(d, d);
+  if (!(a > 0.0)) return std::nullopt;
+  double b = glm::dot(oc, d);  // half the linear coefficient
+  double r = radius_;
+  glm::dvec3 v = oc - (b / a) * d;  // closest approach of the line to the centre
+  double disc = a * (r * r - glm::dot(v, v));  // b^2 - a c, without the cancellation
+  if (disc < 0.0) return std::nullopt;
+  double q = -(b + std::copysign(std::sqrt(disc), b));
+  double c = glm::dot(oc, oc) - r * r;
+  double t0 = q / a, t1 = q != 0.0 ? c / q : t0;
+  if (t0 > t1) std::swap(t0, t1);
+  for (double t : {t0, t1}) {  // compared after rounding, as Embree compares the float it is given
+    float tf = static_cast<float>(t);
+    if (tf > t_min && tf < t_max) return tf;
+  }
+  return std::nullopt;
+}
+
 Vec3 Sphere::reproject(const Vec3& p) const {
   Vec3 d = p - center_;
   return center_ + d * (radius_ / glm::length(d));

@@ -1,8 +1,11 @@
-// Full spheres, placed by a similarity transform (rotation, uniform scale, translation). Embree
-// intersects them with its native sphere primitive; this class samples and parameterises them.
+// Full spheres, placed by a similarity transform (rotation, uniform scale, translation): intersected
+// (as Embree user geometry, EmbreeScene::add_sphere), sampled and parameterised here.
 #pragma once
 
+#include <penumbra/interaction.h>
 #include <penumbra/shape.h>
+
+#include <optional>
 
 namespace penumbra {
 
@@ -14,6 +17,10 @@ class Sphere final : public Shape {
   float radius() const { return radius_; }
   /// Normal at a point on the surface, oriented (outward unless ReverseOrientation).
   Vec3 normal_at(const Vec3& p) const;
+  /// The nearest hit of the ray o + t d with t in (t_min, t_max), solved in double precision with
+  /// the discriminant taken from the ray's closest approach to the centre (pbrt-v4's form, which
+  /// stays accurate for small spheres far from the origin).
+  std::optional<float> intersect(const Ray& ray, float t_min, float t_max) const;
   /// Moves a point near the surface exactly onto it (removes the error of o + t d).
   Vec3 reproject(const Vec3& p) const;
   Vec2 uv_at(const Vec3& p) const;
