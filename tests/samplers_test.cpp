@@ -6,6 +6,7 @@
 #include "registry/registry.h"
 #include "support/chi_square.h"
 
+#include <penumbra/rng.h>
 #include <penumbra/sampler.h>
 
 #include <gmock/gmock.h>
@@ -220,6 +221,23 @@ std::vector<Variant> all_variants() {
   v.insert(v.end(), std::begin(kHaltonVariants), std::end(kHaltonVariants));
   v.push_back({"independent", ""});
   return v;
+}
+
+// Jump-ahead (a table for short jumps, Brown's loop beyond) lands where stepping lands, on several
+// streams, for every short length and a few long ones (the sample-index jumps).
+TEST(Pcg32, AdvanceEqualsSteppingForShortAndLongJumps) {
+  for (uint64_t stream : {0ull, 1ull, 0x9e3779b97f4a7c15ull}) {
+    std::vector<uint64_t> lengths;
+    for (uint64_t n = 0; n <= 300; ++n) lengths.push_back(n);
+    for (uint64_t n : {65536ull, 65536ull * 7 + 13, 1ull << 20}) lengths.push_back(n);
+    for (uint64_t n : lengths) {
+      Pcg32 jumped(stream, 42), stepped(stream, 42);
+      jumped.advance(n);
+      for (uint64_t i = 0; i < n; ++i) stepped.next_u32();
+      ASSERT_EQ(jumped.next_u32(), stepped.next_u32()) << "stream " << stream << ", jump " << n;
+      ASSERT_EQ(jumped.next_u32(), stepped.next_u32()) << "stream " << stream << ", jump " << n;
+    }
+  }
 }
 
 TEST(Samplers, EveryValueIsInTheUnitIntervalIncludingPastTheTables) {

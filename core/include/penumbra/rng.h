@@ -4,6 +4,7 @@
 
 #include <penumbra/math.h>
 
+#include <array>
 #include <cstdint>
 
 namespace penumbra {
@@ -53,6 +54,10 @@ class Pcg32 {
 
   /// Skips `delta` outputs in O(log delta) (Brown's algorithm).
   void advance(uint64_t delta) {
+    if (delta < kJumps.size()) {  // short jumps (a sampler's dimensions): one step from a table
+      state_ = kJumps[delta].mult * state_ + kJumps[delta].inc_factor * inc_;
+      return;
+    }
     uint64_t cur_mult = kMult, cur_plus = inc_, acc_mult = 1u, acc_plus = 0u;
     while (delta > 0) {
       if (delta & 1) {
@@ -68,6 +73,22 @@ class Pcg32 {
 
  private:
   static constexpr uint64_t kMult = 0x5851f42d4c957f2dull;
+  // n steps of state' = kMult state + inc make state_n = mult_n state + inc_factor_n inc, where
+  // mult_n = kMult^n and inc_factor_n = 1 + kMult + ... + kMult^(n-1) (mod 2^64) do not depend on
+  // the stream: advance() skips up to 255 outputs with two multiplications instead of a loop.
+  struct Jump {
+    uint64_t mult, inc_factor;
+  };
+  static constexpr std::array<Jump, 256> kJumps = [] {
+    std::array<Jump, 256> t{};
+    uint64_t mult = 1u, inc_factor = 0u;
+    for (Jump& j : t) {
+      j = Jump{mult, inc_factor};
+      inc_factor = inc_factor * kMult + 1u;
+      mult *= kMult;
+    }
+    return t;
+  }();
   uint64_t state_, inc_;
 };
 
