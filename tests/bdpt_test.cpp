@@ -57,7 +57,7 @@ struct Density {
 };
 
 double bsdf_pdf(const Vertex& v, const Vertex& from, const Vertex& to) {
-  return v.bsdf->pdf(v.shading.to_local(toward(v, from)), v.shading.to_local(toward(v, to)), ShadingContext{v.tex});
+  return v.bsdf->pdf(v.shading.to_local(toward(v, from)), v.shading.to_local(toward(v, to)), ShadingContext{v.sc.tex});
 }
 
 Density light_side(const Scene& scene, const LightChooser& lights, const FullPath& fp, int i) {

@@ -76,7 +76,7 @@ SelLobe CachedConnector::eye_lobe(const Vertex& z, const Vertex& z_next) const {
   Vec3 wo_world = direction_to(z, z_next);
   Vec3 wo = z.shading.to_local(wo_world);
   if (wo.z == 0.f) return lobe;
-  ShadingContext sc{z.tex, TransportMode::Radiance};
+  const ShadingContext& sc = z.sc;  // a camera vertex: radiance
   LobeSummary summary = z.bsdf->lobe(wo, sc);
   float len = glm::length(summary.peak);
   if (!(len > 0.f)) return lobe;
@@ -102,7 +102,7 @@ double CachedConnector::pc_weight(const Vertex& y_prev, const Vertex& y, int cp)
   if (!(dist2 > 0.f)) return 0.0;
   Vec3 wi = d / std::sqrt(dist2);
   Vec3 wo = direction_to(y, y_prev);
-  Rgb f = y.bsdf->f(y.shading.to_local(wo), y.shading.to_local(wi), ShadingContext{y.tex, TransportMode::Importance});
+  Rgb f = y.bsdf->f(y.shading.to_local(wo), y.shading.to_local(wi), y.sc);  // a light vertex: importance
   double w = luminance(f) * std::abs(glm::dot(y.ns, wi)) * std::abs(glm::dot(point.n, wi)) /
              std::max(dist2, pc_radius_ * pc_radius_);
   if (!std::isfinite(w) || !(w > 0.0)) return 0.0;

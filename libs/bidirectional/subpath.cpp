@@ -53,14 +53,14 @@ void make_surface_vertex(Vertex& v, const SurfaceInteraction& si, const Rgb& bet
   v.ng = si.ng;
   v.ns = si.ns;
   v.shading = si.shading;
-  v.tex = si.texture_context();
+  v.sc.tex = si.texture_context();
   v.wo = si.wo;
   v.wo_local = si.shading.to_local(si.wo);
   v.bsdf = si.bsdf;
   v.surface_connectible = si.bsdf && si.bsdf->flags() != 0 && !si.bsdf->is_specular_only();
   v.light = si.area_light;
   v.beta = beta;
-  v.mode = mode;
+  v.sc.mode = mode;
   v.media = si.media;
 }
 
@@ -74,7 +74,7 @@ int medium_side(const Vertex& v, const Vec3& d) {
 // given the local directions towards a and b: one pair of directions for both BSDF densities.
 void surface_pdf_pair(const Vertex& cur, const Vertex& a, const Vec3& wa, const Vertex& b, const Vec3& wb,
                       float* to_b, float* to_a) {
-  ShadingContext sc{cur.tex, cur.mode};
+  const ShadingContext& sc = cur.sc;
   *to_b = convert_density(cur.bsdf->pdf(wa, wb, sc), cur, b);
   *to_a = convert_density(cur.bsdf->pdf(wb, wa, sc), cur, a);
 }
@@ -154,7 +154,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     float u_rr = ps.get_1d();
 
     const Bsdf& bsdf = *v.bsdf;
-    ShadingContext sctx{v.tex, mode};
+    const ShadingContext& sctx = v.sc;
     const Vec3& wo = v.wo_local;
     std::optional<BsdfSample> bs = bsdf.flags() ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
     if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
@@ -211,8 +211,8 @@ Rgb Vertex::f(const Vertex& next) const {
   if (kind != VertexKind::Surface) return Rgb(0.f);
   Vec3 wi = direction_to(*this, next);
   if (leaks(*this, wo, wi)) return Rgb(0.f);
-  Rgb value = bsdf->f(wo_local, shading.to_local(wi), ShadingContext{tex, mode});
-  if (mode == TransportMode::Importance) value *= shading_correction(*this, wo, wi);
+  Rgb value = bsdf->f(wo_local, shading.to_local(wi), sc);
+  if (sc.mode == TransportMode::Importance) value *= shading_correction(*this, wo, wi);
   return value;
 }
 
@@ -258,7 +258,7 @@ float pdf_area(const Context& ctx, const Vertex* prev, const Vertex& cur, const 
     return convert_density(pdf_dir, cur, next);
   }
   Vec3 wp = direction_to(cur, *prev);
-  float pdf_dir = cur.bsdf->pdf(cur.shading.to_local(wp), cur.shading.to_local(wn), ShadingContext{cur.tex, cur.mode});
+  float pdf_dir = cur.bsdf->pdf(cur.shading.to_local(wp), cur.shading.to_local(wn), cur.sc);
   return convert_density(pdf_dir, cur, next);
 }
 
@@ -292,7 +292,7 @@ double next_event_ratio(const Vertex& x0, const Vertex& x1) {
   hit.p = x0.p;
   hit.ng = x0.ng;
   hit.ns = x0.ng;
-  hit.uv = x0.tex.uv;
+  hit.uv = x0.sc.tex.uv;
   float pdf_solid_angle = x0.light->pdf_li(LightSampleContext{x1.p, x1.ng}, wi, hit);
   float pdf_pos, pdf_dir;
   x0.light->pdf_le(Ray{x0.p, -wi}, x0.ng, &pdf_pos, &pdf_dir);
@@ -380,7 +380,7 @@ int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
   y0.infinite = is_at_infinity(sl->light);
   y0.w_light = le->ray.d;
   y0.beta = Rgb(1.f / (sl->pmf * le->pdf_pos));  // emission is evaluated per connection
-  y0.mode = TransportMode::Importance;
+  y0.sc.mode = TransportMode::Importance;
 
   float cos0 = le->n != Vec3(0.f) ? std::abs(glm::dot(le->n, le->ray.d)) : 1.f;
   Rgb beta = le->L * cos0 / (sl->pmf * le->pdf_pos * le->pdf_dir);
@@ -556,8 +556,8 @@ double weight_with(const Context& ctx, const Vertex* light, int s, const Vertex*
 // Vertex::f() towards world direction wi (local wi_local), wi = direction_to(v, next).
 Rgb surface_f(const Vertex& v, const Vec3& wi, const Vec3& wi_local) {
   if (leaks(v, v.wo, wi)) return Rgb(0.f);
-  Rgb value = v.bsdf->f(v.wo_local, wi_local, ShadingContext{v.tex, v.mode});
-  if (v.mode == TransportMode::Importance) value *= shading_correction(v, v.wo, wi);
+  Rgb value = v.bsdf->f(v.wo_local, wi_local, v.sc);
+  if (v.sc.mode == TransportMode::Importance) value *= shading_correction(v, v.wo, wi);
   return value;
 }
 
@@ -648,7 +648,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       return c;
     }
     if (!pt.light) return c;
-    c.L = pt.beta * pt.light->L(pt.p, pt.ng, pt.tex.uv, direction_to(pt, camera[t - 2]));
+    c.L = pt.beta * pt.light->L(pt.p, pt.ng, pt.sc.tex.uv, direction_to(pt, camera[t - 2]));
     finish(nullptr, nullptr);
     return c;
   }
@@ -674,7 +674,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     if (qs.kind == VertexKind::Surface)
       c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
     else  // a point on an area light seen directly (light tracing's s = 1)
-      c.L = qs.beta * qs.light->L(qs.p, qs.ng, qs.tex.uv, cw->wi) * std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
+      c.L = qs.beta * qs.light->L(qs.p, qs.ng, qs.sc.tex.uv, cw->wi) * std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
     if (scene.has_media())
       c.L *= scene.segment_transmittance(medium_side(qs, cw->wi), kMediumUnknown, glm::length(cam.p - qs.p));
     if (is_black(c.L) || scene.occluded(shadow_ray(qs, cam.p, Vec3(0.f)))) {
@@ -717,7 +717,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     lv.infinite = is_at_infinity(sl->light);
     lv.w_light = -ls->wi;
     lv.beta = ls->L / (ls->pdf * sl->pmf);
-    lv.mode = TransportMode::Importance;
+    lv.sc.mode = TransportMode::Importance;
     // Both emission densities of the sampled point from one pdf_le() call (pdf_light_origin() and
     // pdf_light_dir() towards pt).
     float pdf_pos = 0.f, pdf_dir = 0.f, to_pt = 0.f;

@@ -68,7 +68,10 @@ struct Vertex {
   Vec3 p_error{0.f};      // bound on the floating-point error of p (surfaces), for ray offsets
   Vec3 ng{0.f}, ns{0.f};  // zero for points not on a surface (point lights, the lens)
   Frame shading;
-  TextureEvalContext tex;  // surfaces: where textured materials are evaluated (tex.uv: the uv)
+  // Surfaces: where textured materials are evaluated (sc.tex; sc.tex.uv is the uv); every vertex: its
+  // subpath's transport mode (sc.mode). Kept as the BSDF's argument itself, which every f(), pdf() and
+  // sample_f() takes by reference, so the calls do not build one (76 bytes) each.
+  ShadingContext sc;
   Vec3 wo{0.f};           // surfaces: unit direction towards the previous vertex of the subpath
   Vec3 wo_local{0.f};     // surfaces: wo in the shading frame (every f() and the sampling need it)
   // Surfaces: unit direction towards the previous vertex from their positions, in the shading frame:
@@ -82,12 +85,11 @@ struct Vertex {
   float pdf_rev = 0.f;    // area density from the next one, as if generated from the other end
   bool delta = false;     // scattered specularly towards the next vertex
   bool infinite = false;  // a direction rather than a point (escaped camera ray, environment, distant)
-  TransportMode mode = TransportMode::Radiance;
   MediumInterface media;  // surfaces: the media on their two sides (absorption between vertices)
   int16_t medium = kMediumUnknown;  // surfaces: the medium the subpath arrived in, where known
   // Light endpoints traced by light_subpath(): next_event_ratio(path[0], path[1]), which every
   // connection with s >= 2 light vertices needs for its MIS weight (NaN: not known, computed when
-  // needed). Fits in the padding after `mode`.
+  // needed).
   float nee_ratio = std::numeric_limits<float>::quiet_NaN();
   // Sum over the strategies that move this vertex and every vertex between it and its subpath's
   // start to the other side, of (p_i / p_s)^beta with p_s the strategy that connects just beyond it
@@ -114,7 +116,9 @@ struct Config {
   int max_depth = 5;  // bounces: strategies with s + t - 2 <= max_depth
   int rr_depth = 3;   // bounces of a subpath before Russian roulette may end it
   MisHeuristic heuristic = MisHeuristic::Power;
-  bool store_nee_ratio = true;  // light_subpath() fills Vertex::nee_ratio (MIS needs it; light tracing does not)
+  // light_subpath() fills Vertex::nee_ratio and the folded sums (Vertex::mis_sum): every weighted
+  // connection needs them; unweighted light tracing does not.
+  bool store_nee_ratio = true;
 };
 
 /// Reads and checks the parameters bdpt and lighttracing share: "maxdepth", "rrdepth" and

@@ -83,9 +83,9 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
 }
 
 // User-geometry callbacks for spheres, disks and cylinders (one primitive per geometry; rays come one
-// at a time from rtcIntersect1/rtcOccluded1). Embree's native sphere primitive (RTC_GEOMETRY_TYPE_
-// SPHERE_POINT) cost about 400 instructions per ray on a scene of two spheres and ten triangles, as much
-// as the whole triangle BVH; the analytic test here costs a fraction of that (docs/benchmarks.md).
+// at a time from rtcIntersect1/rtcOccluded1). On the benchmark scenes (ten triangles, two spheres)
+// Embree's native sphere primitive (RTC_GEOMETRY_TYPE_SPHERE_POINT) added about 400 instructions per
+// ray to the triangles' 412; as user geometry the spheres add about 310 (docs/bdpt.md).
 static void user_bounds(const RTCBoundsFunctionArguments* args) {
   const auto* data = static_cast<const GeometryUserData*>(args->geometryUserPtr);
   Bounds3 b = data->quadric ? data->quadric->world_bounds()
