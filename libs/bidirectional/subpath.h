@@ -91,11 +91,11 @@ struct Vertex {
   // connection with s >= 2 light vertices needs for its MIS weight (NaN: not known, computed when
   // needed).
   float nee_ratio = std::numeric_limits<float>::quiet_NaN();
-  // Sum over the strategies that move this vertex and every vertex between it and its subpath's
-  // start to the other side, of (p_i / p_s)^beta with p_s the strategy that connects just beyond it
-  // (0 for the lens and where nothing can move): set by camera_subpath() and light_subpath() for the
-  // O(1) weights (see the top of this file); valid for every connection that changes neither this
-  // vertex nor those before it.
+  // For vertex j of its subpath: the sum of (p_i / p_j')^beta over the possible strategies i that
+  // give this vertex, and the vertices back to some earlier one, to the other subpath, where p_j' is
+  // the strategy whose own side ends at this vertex (0 for the lens: no strategy moves it). Set by
+  // camera_subpath() and light_subpath() for the O(1) weights (see the top of this file); valid for
+  // every connection that changes neither this vertex nor those before it.
   double mis_sum = 0.0;
 
   bool on_surface() const { return ng != Vec3(0.f); }
