@@ -144,4 +144,25 @@ TEST(Gltf, BrokenFilesAreLocatedErrorsNamingTheFile) {
   expect_error("index.gltf", cube_gltf(R"([{"mesh": 0}])", 4, 0, 0xFFFFFFFFu),
                "mesh 'cube' primitive 0 has index 4294967295, but only 8 vertices");
   expect_error("index8.gltf", cube_gltf(R"([{"mesh": 0}])", 4, 0, 8u), "has index 8, but only 8 vertices");
+  // A NORMAL accessor with fewer elements than POSITION (found by the fuzzer: the mesh would have
+  // been read past its normals).
+  auto replace = [](std::string s, const std::string& from, const std::string& to) {
+    size_t at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? s : s.replace(at, from.size(), to);
+  };
+  std::string cube = cube_gltf(R"([{"mesh": 0}])");
+  std::string normals = replace(replace(cube, R"("POSITION": 0})", R"("POSITION": 0, "NORMAL": 2})"),
+                                R"("type": "SCALAR"}])",
+                                R"("type": "SCALAR"}, {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"}])");
+  expect_error("normals.gltf", normals, "mesh 'cube' primitive 0 has 4 NORMAL values but 8 positions");
+  // A count so large that count x stride wraps around 64 bits is still past the end.
+  expect_error("count.gltf", replace(cube, R"("count": 8,)", R"("count": 1537228672809129302,)"),
+               "reads past the end of its buffer");
+  // 40 nodes that each name the next one twice: 2^40 node instances (the last node has no mesh, so
+  // that the test does not copy one a million times before the limit).
+  std::string chain = "[{\"mesh\": 0, \"children\": [1]}, ";
+  for (int i = 1; i < 40; ++i) chain += fmt::format(R"({{"children": [{}, {}]}}, )", i + 1, i + 1);
+  chain += "{}]";
+  expect_error("chain.gltf", cube_gltf(chain), "the node tree expands to more than 1000000 node instances");
 }

@@ -7,6 +7,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <tiny_gltf.h>
 
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -61,11 +62,18 @@ class Reader {
     if (size <= 0) fail(fmt::format("{} has an unknown component type {}", what, a.componentType));
     int stride = a.ByteStride(view);
     if (stride <= 0) fail(fmt::format("{} has an invalid byte stride", what));
-    size_t begin = view.byteOffset + a.byteOffset;
-    size_t end = a.count == 0 ? begin : begin + (a.count - 1) * stride + static_cast<size_t>(n) * size;
-    if (end > data.size() || end > view.byteOffset + view.byteLength)
-      fail(fmt::format("{} reads past the end of its buffer ({} bytes needed, {} available)", what, end,
-                       std::min<size_t>(data.size(), view.byteOffset + view.byteLength)));
+    // Every offset and the count come from the file: compared by division, so that no product or
+    // sum can wrap around.
+    size_t view_end = view.byteLength > SIZE_MAX - view.byteOffset ? SIZE_MAX : view.byteOffset + view.byteLength;
+    size_t available = std::min(data.size(), view_end);
+    size_t element = static_cast<size_t>(n) * size;
+    bool fits = view.byteOffset <= available && a.byteOffset <= available - view.byteOffset;
+    size_t begin = fits ? view.byteOffset + a.byteOffset : available;
+    if (fits && a.count > 0)
+      fits = element <= available - begin && a.count - 1 <= (available - begin - element) / static_cast<size_t>(stride);
+    if (!fits)
+      fail(fmt::format("{} reads past the end of its buffer ({} elements of {} bytes from byte {}, {} bytes available)",
+                       what, a.count, element, view.byteOffset + a.byteOffset, available));
     std::vector<double> out;
     out.reserve(a.count * n);
     for (size_t i = 0; i < a.count; ++i)
@@ -123,19 +131,29 @@ std::vector<GltfPrimitive> load_gltf(const std::string& path, const FileLoc& loc
   bool binary = std::filesystem::path(path).extension() == ".glb";
   std::string base_dir = std::filesystem::path(path).parent_path().string();
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned>(bytes.size()), base_dir)
-                   : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()),
-                                                base_dir);
+  bool ok = false;
+  try {  // tinygltf reports through `err`, but a buffer length it believes can still fail to allocate
+    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned>(bytes.size()), base_dir)
+                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base_dir);
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
   if (!ok) throw Error(loc, fmt::format("glTF file '{}' cannot be read: {}", path, err.empty() ? warn : err));
   Reader reader(model, path, loc);
   if (!model.textures.empty())
     warning(loc, fmt::format("glTF file '{}': textures are ignored; material factors are used", path));
 
   std::vector<GltfPrimitive> out;
-  // Walks the node tree, accumulating transforms; a node visited twice is an instance of its mesh.
+  // Walks the node tree, accumulating transforms; a node visited twice is an instance of its mesh,
+  // copied. A few nodes that name each other several times can expand to astronomically many
+  // instances: the walk stops with an error past kMaxNodeVisits.
+  constexpr size_t kMaxNodeVisits = 1'000'000;
+  size_t visits = 0;
   std::function<void(int, const glm::dmat4&, int)> visit = [&](int node_index, const glm::dmat4& parent, int depth) {
     if (node_index < 0 || node_index >= static_cast<int>(model.nodes.size()) || depth > 64)
       reader.fail(fmt::format("node {} does not exist or the node tree is cyclic", node_index));
+    if (++visits > kMaxNodeVisits)
+      reader.fail(fmt::format("the node tree expands to more than {} node instances", kMaxNodeVisits));
     const tinygltf::Node& node = model.nodes[node_index];
     glm::dmat4 m = parent * node_transform(node);
     if (node.mesh >= 0) {
@@ -152,12 +170,19 @@ std::vector<GltfPrimitive> load_gltf(const std::string& path, const FileLoc& loc
         GltfPrimitive g;
         std::vector<double> p = reader.read(pos->second, 3, (what + " POSITION").c_str());
         for (size_t i = 0; i < p.size(); i += 3) g.P.push_back(Vec3(m * glm::dvec4(p[i], p[i + 1], p[i + 2], 1.0)));
+        auto same_count = [&](const std::vector<double>& values, size_t per_vertex, const char* attribute) {
+          if (values.size() / per_vertex != g.P.size())
+            reader.fail(fmt::format("{} has {} {} values but {} positions", what, values.size() / per_vertex, attribute,
+                                    g.P.size()));
+        };
         if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
           std::vector<double> n = reader.read(it->second, 3, (what + " NORMAL").c_str());
+          same_count(n, 3, "NORMAL");
           for (size_t i = 0; i < n.size(); i += 3) g.N.push_back(Vec3(glm::normalize(normal_matrix * glm::dvec3(n[i], n[i + 1], n[i + 2]))));
         }
         if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
           std::vector<double> t = reader.read(it->second, 2, (what + " TEXCOORD_0").c_str());
+          same_count(t, 2, "TEXCOORD_0");
           for (size_t i = 0; i < t.size(); i += 2) g.uv.push_back(Vec2(t[i], t[i + 1]));
         }
         if (prim.indices >= 0) {
