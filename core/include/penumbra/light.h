@@ -20,10 +20,25 @@ inline bool is_delta_light(LightType t) {
 }
 
 /// The receiving point of a light sample: position, geometric normal (zero if none).
+///
+/// allow_incomplete_pdf (pbrt-v4's allowIncompletePDF): the caller combines sample_li() with BSDF
+/// sampling by MIS, asking pdf_li() with the same context for the weights, and n is the geometric
+/// normal turned to the side the light is gathered on. A light may then leave directions to BSDF
+/// sampling, with sample_li() and pdf_li() agreeing on them (density 0 there): a constant
+/// environment samples cosine-weighted directions on n's side instead of uniform ones over the
+/// sphere. Estimators that need every path from light sampling alone (bidirectional MIS, light
+/// tracing) leave it false.
 struct LightSampleContext {
   Vec3 p;
   Vec3 n{0.f};
+  bool allow_incomplete_pdf = false;
 };
+
+/// The context for light sampling at a surface hit that is combined with BSDF sampling by MIS: the
+/// geometric normal on the side of wo, allow_incomplete_pdf set.
+inline LightSampleContext mis_light_context(const SurfaceInteraction& si) {
+  return LightSampleContext{si.p, glm::dot(si.ng, si.wo) < 0.f ? -si.ng : si.ng, true};
+}
 
 struct LightLiSample {
   Rgb L{0.f};      // incident radiance (before visibility)

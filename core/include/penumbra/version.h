@@ -18,7 +18,8 @@
 // 8: absorbing media: SurfaceInteraction::media (MediumInterface), Scene::has_media(),
 //    Scene::transmittance(); Param::from_attribute.
 // 9: Shape::present() (alpha cut-outs on area lights).
-#define PENUMBRA_SDK_VERSION 9
+// 10: LightSampleContext::allow_incomplete_pdf.
+#define PENUMBRA_SDK_VERSION 10
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

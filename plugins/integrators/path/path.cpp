@@ -102,7 +102,7 @@ class PathIntegrator final : public PixelIntegrator {
       specular_bounce = bs->is_specular();
       bsdf_pdf = bs->pdf;
       if (bs->flags & BsdfTransmission) eta_scale *= sqr(bs->eta);
-      prev_ctx = LightSampleContext{si->p, si->ng};
+      prev_ctx = mis_light_context(*si);
       ray = si->spawn_ray(wi);
       medium = si->media.leaving(si->ng, wi, medium);
 
@@ -122,7 +122,7 @@ class PathIntegrator final : public PixelIntegrator {
                     const Scene& scene, float u_light, Vec2 u, int arrived_in) const {
     std::optional<SampledLight> sl = scene.sample_light(u_light);
     if (!sl) return Rgb(0.f);
-    LightSampleContext lctx{si.p, si.ng};
+    LightSampleContext lctx = mis_light_context(si);
     std::optional<LightLiSample> ls = sl->light->sample_li(lctx, u);
     if (!ls || !(ls->pdf > 0.f) || is_black(ls->L)) return Rgb(0.f);
     Vec3 wi = si.shading.to_local(ls->wi);

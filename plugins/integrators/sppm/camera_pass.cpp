@@ -45,7 +45,7 @@ Rgb escaped_light(const Scene& scene, const Ray& ray, const LightSampleContext& 
 Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
                  const Scene& scene, const DirectSamples& u, RaysFind rays_find, int arrived_in) {
   Rgb L(0.f);
-  LightSampleContext lctx{si.p, si.ng};
+  LightSampleContext lctx = mis_light_context(si);
   if (std::optional<SampledLight> sl = scene.sample_light(u.u_light)) {
     std::optional<LightLiSample> ls = sl->light->sample_li(lctx, u.u_light_point);
     if (ls && ls->pdf > 0.f && !is_black(ls->L)) {

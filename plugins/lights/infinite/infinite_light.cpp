@@ -63,6 +63,14 @@ class InfiniteLight final : public Light {
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
     Vec3 w_light;
     float pdf;
+    if (cosine_side(ctx)) {
+      // Constant radiance seen from a surface whose caller MIS-combines with BSDF sampling
+      // (LightSampleContext): cosine-weighted on the normal's side, the other side left to the BSDF.
+      Vec3 wi = Frame(ctx.n).to_world(sample_cosine_hemisphere(u));
+      pdf = cosine_hemisphere_pdf(glm::dot(glm::normalize(wi), ctx.n));  // as pdf_li() computes it
+      if (!(pdf > 0.f) || is_black(constant_)) return std::nullopt;
+      return LightLiSample{constant_, wi, pdf, ctx.p + wi * (2.f * radius_), Vec3(0.f)};
+    }
     if (!has_image()) {
       w_light = sample_uniform_sphere(u);
       pdf = uniform_sphere_pdf();
@@ -80,7 +88,8 @@ class InfiniteLight final : public Light {
     return LightLiSample{L, wi, pdf, ctx.p + wi * (2.f * radius_), Vec3(0.f)};
   }
 
-  float pdf_li(const LightSampleContext&, const Vec3& wi, const SurfaceInteraction&) const override {
+  float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const SurfaceInteraction&) const override {
+    if (cosine_side(ctx)) return cosine_hemisphere_pdf(glm::dot(glm::normalize(wi), ctx.n));
     if (!has_image()) return uniform_sphere_pdf();
     Vec3 w = to_light_ * glm::normalize(wi);
     return pdf_uv_to_solid_angle(distribution_.pdf(envmap::direction_to_uv(mapping_, w)), w);
@@ -110,6 +119,11 @@ class InfiniteLight final : public Light {
 
  private:
   bool has_image() const { return image_.width > 0; }
+  // Whether sample_li()/pdf_li() draw cosine-weighted directions around ctx.n (a constant sky, a
+  // receiving normal, and a caller that allows an incomplete density).
+  bool cosine_side(const LightSampleContext& ctx) const {
+    return !has_image() && ctx.allow_incomplete_pdf && ctx.n != Vec3(0.f);
+  }
 
   // Equal-area texels all cover 4 pi / (w h) sr; equirectangular ones d(omega) = 2 pi^2 sin(theta) du dv.
   float pdf_uv_to_solid_angle(float pdf_uv, const Vec3& w_light) const {
