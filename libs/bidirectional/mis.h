@@ -18,9 +18,10 @@
 // Strategies that would have to connect through a delta vertex get 0.
 //
 // Two strategies do not follow the product rule and are corrected by a factor:
-//  - s = 1 picks x_0 with the light's own sampling seen from x_1 (spherical triangles, cones), not
-//    with its emission sampling: nee_ratio = p_nee(x_0 | x_1) / pdf_light(0) (1 for lights whose
-//    two samplings coincide: delta and environment lights).
+//  - s = 1 picks x_0 with the light's own sampling seen from x_1 (spherical triangles, cones, a
+//    constant sky's cosine-weighted directions about x_1's normal), not with its emission sampling:
+//    nee_ratio = p_nee(x_0 | x_1) / pdf_light(0) (1 for lights whose two samplings coincide: delta
+//    lights and image environments).
 //  - t = 0 (light paths hitting the lens) is never used: the lens is not in the scene.
 // Further connection techniques for the same edge (issue 6: probabilistic connections, hierarchical
 // Russian roulette) enter through `technique_sums`: technique tau with density c_tau(i) p_i adds

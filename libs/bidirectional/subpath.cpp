@@ -277,13 +277,27 @@ double next_event_ratio_from(const Vertex& x0, const Vertex& x1, float pdf_solid
 }
 
 bool next_event_ratio_applies(const Vertex& x0, const Vertex& x1) {
-  return x0.light && x0.light->type() == LightType::Area && x1.on_surface();
+  return x0.light && (x0.light->type() == LightType::Area || x0.light->type() == LightType::Infinite) &&
+         x1.on_surface();
+}
+
+// The same for an environment light: pdf_li()'s density of the direction seen from x1 (a constant
+// sky samples about x1's normal) over the emission's density of that direction.
+double infinite_next_event_ratio(float pdf_solid_angle, float pdf_dir) {
+  return pdf_dir > 0.f && pdf_solid_angle != pdf_dir ? static_cast<double>(pdf_solid_angle) / pdf_dir : 1.0;
 }
 
 }  // namespace
 
 double next_event_ratio(const Vertex& x0, const Vertex& x1) {
   if (!next_event_ratio_applies(x0, x1)) return 1.0;
+  if (x0.infinite) {
+    SurfaceInteraction none;
+    float pdf_solid_angle = x0.light->pdf_li(LightSampleContext{x1.p, x1.ng}, -x0.w_light, none);
+    float pdf_pos, pdf_dir;
+    x0.light->pdf_le(Ray{x0.p, x0.w_light}, Vec3(0.f), &pdf_pos, &pdf_dir);
+    return infinite_next_event_ratio(pdf_solid_angle, pdf_dir);
+  }
   Vec3 d = x0.p - x1.p;
   float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.f)) return 1.0;
@@ -751,7 +765,9 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     patch.light_0 = lv.pdf_fwd;
     surface_pdf_pair(pt, lv, wl, camera[t - 2], pt.w_prev_local, &patch.light_s1, &patch.camera_s1);
     // sample_li() drew lv with the density next_event_ratio() asks pdf_li() for.
-    patch.nee_ratio = next_event_ratio_applies(lv, pt) ? next_event_ratio_from(lv, pt, ls->pdf, pdf_pos) : 1.0;
+    patch.nee_ratio = !next_event_ratio_applies(lv, pt) ? 1.0
+                      : lv.infinite ? infinite_next_event_ratio(ls->pdf, pdf_dir)
+                                    : next_event_ratio_from(lv, pt, ls->pdf, pdf_pos);
     c.weight = weight_with(ctx, light, s, camera, t, &lv, nullptr, Technique::Regular, patch);
     c.weighted = c.L * static_cast<float>(c.weight);
     return c;

@@ -258,7 +258,7 @@ float pdf_light_dir(const Vertex& cur, const Vertex& next);
 /// Density of choosing `cur` as the origin of an emitted path (selection pmf included).
 float pdf_light_origin(const Context& ctx, const Vertex& cur, const Vertex& next);
 /// p_nee(x0 | x1) / pdf_light_origin(x0): how much more likely next-event estimation from x1 is to
-/// pick x0 than emission sampling (1 unless x0 is on an area light).
+/// pick x0 than emission sampling (1 unless x0 is on an area light or is a constant sky's direction).
 double next_event_ratio(const Vertex& x0, const Vertex& x1);
 
 }  // namespace penumbra::bdpt

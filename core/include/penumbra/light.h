@@ -25,8 +25,7 @@ inline bool is_delta_light(LightType t) {
 /// sampling by MIS, asking pdf_li() with the same context for the weights, and n is the geometric
 /// normal turned to the side the light is gathered on. A light may then leave directions to BSDF
 /// sampling, with sample_li() and pdf_li() agreeing on them (density 0 there): a constant
-/// environment samples cosine-weighted directions on n's side instead of uniform ones over the
-/// sphere. Estimators that need every path from light sampling alone (bidirectional MIS, light
+/// environment samples cosine-weighted directions on n's side only instead of on both. Estimators that need every path from light sampling alone (bidirectional MIS, light
 /// tracing) leave it false.
 struct LightSampleContext {
   Vec3 p;

@@ -16,7 +16,10 @@
 // constant distribution over the image, so the pdf per solid angle is exact: pdf_uv / (4 pi) for the
 // equal-area map (its texels all cover the same solid angle, the distribution is luminance alone),
 // pdf_uv / (2 pi^2 sin theta) for the equirectangular one (distribution luminance x sin theta). The
-// distribution is built only when the scene has an image-based environment.
+// distribution is built only when the scene has an image-based environment. A constant sky seen
+// from a surface (a receiving normal in the LightSampleContext) is sampled cosine-weighted about the
+// normal: on both sides, or on the normal's side alone when the caller allows an incomplete density;
+// without a normal (emission, media), uniformly over the sphere.
 #include <penumbra/image.h>
 #include <penumbra/light.h>
 #include <penumbra/plugin.h>
@@ -63,11 +66,18 @@ class InfiniteLight final : public Light {
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
     Vec3 w_light;
     float pdf;
-    if (cosine_side(ctx)) {
-      // Constant radiance seen from a surface whose caller MIS-combines with BSDF sampling
-      // (LightSampleContext): cosine-weighted on the normal's side, the other side left to the BSDF.
-      Vec3 wi = Frame(ctx.n).to_world(sample_cosine_hemisphere(u));
-      pdf = cosine_hemisphere_pdf(glm::dot(glm::normalize(wi), ctx.n));  // as pdf_li() computes it
+    if (!has_image() && ctx.n != Vec3(0.f)) {
+      // Constant radiance seen from a surface: cosine-weighted about the normal. On the normal's side
+      // only when the caller MIS-combines with BSDF sampling (LightSampleContext), else on both
+      // sides, each with probability 1/2 (the first coordinate picks the side).
+      Vec3 n = ctx.n;
+      if (!ctx.allow_incomplete_pdf) {
+        bool below = u.x >= 0.5f;
+        u.x = std::min(below ? 2.f * u.x - 1.f : 2.f * u.x, OneMinusEpsilon);
+        if (below) n = -n;
+      }
+      Vec3 wi = Frame(n).to_world(sample_cosine_hemisphere(u));
+      pdf = constant_pdf(ctx, wi);  // as pdf_li() computes it
       if (!(pdf > 0.f) || is_black(constant_)) return std::nullopt;
       return LightLiSample{constant_, wi, pdf, ctx.p + wi * (2.f * radius_), Vec3(0.f)};
     }
@@ -89,8 +99,7 @@ class InfiniteLight final : public Light {
   }
 
   float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const SurfaceInteraction&) const override {
-    if (cosine_side(ctx)) return cosine_hemisphere_pdf(glm::dot(glm::normalize(wi), ctx.n));
-    if (!has_image()) return uniform_sphere_pdf();
+    if (!has_image()) return constant_pdf(ctx, wi);
     Vec3 w = to_light_ * glm::normalize(wi);
     return pdf_uv_to_solid_angle(distribution_.pdf(envmap::direction_to_uv(mapping_, w)), w);
   }
@@ -119,10 +128,12 @@ class InfiniteLight final : public Light {
 
  private:
   bool has_image() const { return image_.width > 0; }
-  // Whether sample_li()/pdf_li() draw cosine-weighted directions around ctx.n (a constant sky, a
-  // receiving normal, and a caller that allows an incomplete density).
-  bool cosine_side(const LightSampleContext& ctx) const {
-    return !has_image() && ctx.allow_incomplete_pdf && ctx.n != Vec3(0.f);
+  // sample_li()'s density for a constant sky: uniform over the sphere without a receiving normal,
+  // else cosine-weighted about it, on its side only (allow_incomplete_pdf) or on both.
+  static float constant_pdf(const LightSampleContext& ctx, const Vec3& wi) {
+    if (ctx.n == Vec3(0.f)) return uniform_sphere_pdf();
+    float cos = glm::dot(glm::normalize(wi), ctx.n);
+    return ctx.allow_incomplete_pdf ? cosine_hemisphere_pdf(cos) : 0.5f * cosine_hemisphere_pdf(std::abs(cos));
   }
 
   // Equal-area texels all cover 4 pi / (w h) sr; equirectangular ones d(omega) = 2 pi^2 sin(theta) du dv.
