@@ -19,14 +19,16 @@ inline bool is_delta_light(LightType t) {
   return t == LightType::DeltaPosition || t == LightType::DeltaDirection;
 }
 
-/// The receiving point of a light sample: position, geometric normal (zero if none).
+/// The receiving point of a light sample: position, geometric normal (zero if none). A light may
+/// shape its samples by the normal: a constant sky draws cosine-weighted directions about it, on
+/// both sides.
 ///
 /// allow_incomplete_pdf (pbrt-v4's allowIncompletePDF): the caller combines sample_li() with BSDF
 /// sampling by MIS, asking pdf_li() with the same context for the weights, and n is the geometric
 /// normal turned to the side the light is gathered on. A light may then leave directions to BSDF
-/// sampling, with sample_li() and pdf_li() agreeing on them (density 0 there): a constant
-/// environment samples cosine-weighted directions on n's side only instead of on both. Estimators that need every path from light sampling alone (bidirectional MIS, light
-/// tracing) leave it false.
+/// sampling, with sample_li() and pdf_li() agreeing on them (density 0 there): a constant sky then
+/// samples n's side only. Estimators that need every path from light sampling alone (bidirectional
+/// MIS, light tracing) leave it false.
 struct LightSampleContext {
   Vec3 p;
   Vec3 n{0.f};
