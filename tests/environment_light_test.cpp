@@ -190,6 +190,9 @@ TEST(EnvironmentLight, ConstantSkyDrawsCosineWeightedDirectionsAboutTheReceiving
     }
   }
   EXPECT_NEAR(below, 500, 60);  // each side with probability 1/2 (about 4 standard deviations)
+  // What bidirectional MIS asks before comparing next-event and emission densities.
+  EXPECT_TRUE(constant->li_density_depends_on_receiver());
+  EXPECT_FALSE(image->li_density_depends_on_receiver());
   for (const LightSampleContext& ctx : {both, one}) {
     auto sample = [&](Vec2 u, float) -> std::optional<Vec3> {
       auto s = constant->sample_li(ctx, u);

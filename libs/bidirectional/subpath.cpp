@@ -277,8 +277,7 @@ double next_event_ratio_from(const Vertex& x0, const Vertex& x1, float pdf_solid
 }
 
 bool next_event_ratio_applies(const Vertex& x0, const Vertex& x1) {
-  return x0.light && (x0.light->type() == LightType::Area || x0.light->type() == LightType::Infinite) &&
-         x1.on_surface();
+  return x0.light && x1.on_surface() && x0.light->li_density_depends_on_receiver();
 }
 
 // The same for an environment light: pdf_li()'s density of the direction seen from x1 (a constant

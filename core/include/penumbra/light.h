@@ -73,6 +73,11 @@ class Light : public Object {
   /// Samples an emitted ray: u_pos chooses the origin, u_dir the direction. The power of the light is
   /// E[L |cos| / (pdf_pos pdf_dir)] (tested for every light).
   virtual std::optional<LightLeSample> sample_le(Vec2 u_pos, Vec2 u_dir) const = 0;
+  /// Whether sample_li()'s density of a point or direction depends on the receiving point (area
+  /// lights; a constant sky, which samples about the receiving normal), or is the emission's own
+  /// density for every receiver (delta lights, image environments). Bidirectional MIS compares the
+  /// two only where they can differ.
+  virtual bool li_density_depends_on_receiver() const { return type() == LightType::Area; }
   /// Densities with which sample_le() produces `ray` (with surface normal n at its origin, if any).
   virtual void pdf_le(const Ray& ray, const Vec3& n, float* pdf_pos, float* pdf_dir) const = 0;
 

@@ -18,7 +18,7 @@
 // 8: absorbing media: SurfaceInteraction::media (MediumInterface), Scene::has_media(),
 //    Scene::transmittance(); Param::from_attribute.
 // 9: Shape::present() (alpha cut-outs on area lights).
-// 10: LightSampleContext::allow_incomplete_pdf.
+// 10: LightSampleContext::allow_incomplete_pdf; Light::li_density_depends_on_receiver().
 #define PENUMBRA_SDK_VERSION 10
 #endif
 

@@ -98,6 +98,9 @@ class InfiniteLight final : public Light {
     return LightLiSample{L, wi, pdf, ctx.p + wi * (2.f * radius_), Vec3(0.f)};
   }
 
+  // A constant sky samples about the receiving normal; a map by its distribution alone.
+  bool li_density_depends_on_receiver() const override { return !has_image(); }
+
   float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const SurfaceInteraction&) const override {
     if (!has_image()) return constant_pdf(ctx, wi);
     Vec3 w = to_light_ * glm::normalize(wi);
