@@ -2,16 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
-#include "spectra/named_spectra.h"
 #include "spectra/spectrum_tables.h"
 
 namespace penumbra::spectra {
 
-namespace {
-
 // Colour-matching functions, linear between their 1 nm samples.
-glm::dvec3 cmf(double lambda) {
+glm::dvec3 cmf_at(double lambda) {
   const CmfTable& t = kCmf;
   double x = lambda - t.first_lambda;
   if (x < 0.0 || x > t.count - 1) return glm::dvec3(0.0);
@@ -20,6 +18,8 @@ glm::dvec3 cmf(double lambda) {
   auto lerp = [&](const float* v) { return (1.0 - f) * v[i] + f * v[i + 1]; };
   return {lerp(t.x), lerp(t.y), lerp(t.z)};
 }
+
+namespace {
 
 // Sorted union of the CMF grid and the breakpoints of s and w inside [360, 830].
 std::vector<double> merged_breakpoints(const Spectrum& s, const Spectrum* w) {
@@ -82,7 +82,7 @@ Spectrum Spectrum::scaled(double factor) const {
 // interval is exact (for blackbodies its error is far below float precision at 1 nm spacing).
 glm::dvec3 spectrum_to_xyz(const Spectrum& s, bool under_d65) {
   const Spectrum* w = under_d65 ? &d65() : nullptr;
-  auto integrand = [&](double l) { return cmf(l) * (s(l) * (w ? (*w)(l) : 1.0)); };
+  auto integrand = [&](double l) { return cmf_at(l) * (s(l) * (w ? (*w)(l) : 1.0)); };
   std::vector<double> b = merged_breakpoints(s, w);
   glm::dvec3 sum(0.0);
   for (size_t i = 0; i + 1 < b.size(); ++i) {
@@ -124,7 +124,8 @@ Rgb emission_to_rgb(const Spectrum& s) {
 
 const Spectrum& d65() {
   static const Spectrum s = [] {
-    const TabulatedSpectrum* t = find_table("stdillum-D65");
+    const TabulatedSpectrum* t = kNamedTables;
+    while (std::strcmp(t->name, "stdillum-D65") != 0) ++t;  // always present (data/spectra)
     std::vector<double> l(t->lambda, t->lambda + t->count), v(t->value, t->value + t->count);
     return Spectrum(std::move(l), std::move(v));
   }();

@@ -51,6 +51,10 @@ class Spectrum {
   double blackbody_peak_ = 1.0;
 };
 
+/// The CIE 1931 2-degree colour-matching functions (x, y, z) at `lambda` nm, linear between their
+/// 1 nm samples, zero outside [360, 830].
+glm::dvec3 cmf_at(double lambda);
+
 /// Planck's law: spectral radiance of a blackbody at `lambda_nm` and `kelvin`, in W / (m^2 sr m).
 double planck(double lambda_nm, double kelvin);
 
