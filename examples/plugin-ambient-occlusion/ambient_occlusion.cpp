@@ -21,7 +21,7 @@ class AmbientOcclusion final : public PixelIntegrator {
  public:
   AmbientOcclusion(bool cos_sample, float max_distance) : cos_sample_(cos_sample), max_distance_(max_distance) {}
 
-  Rgb Li(const Ray& ray, Sampler& sampler, const Scene& scene) const override {
+  Rgb Li(const Ray& ray, const SampledWavelengths*, Sampler& sampler, const Scene& scene) const override {
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
     Vec2 u = sampler.get_2d();  // drawn for misses too, so every sample uses the same dimensions
     if (!si) return Rgb(0.f);

@@ -12,6 +12,7 @@
 #include <penumbra/object.h>
 #include <penumbra/sampler.h>
 #include <penumbra/scene.h>
+#include <penumbra/spectrum.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -29,6 +30,9 @@ struct RenderOptions {
                                // photon mapping, which seeds each part by its first iteration)
   double time_budget = 0.0;    // seconds; 0 means no limit
   int threads = 0;             // 0: all cores
+  bool spectral = false;       // spectral transport (penumbra/spectrum.h): each pixel sample carries
+                               // three wavelengths (PixelSample::wavelengths), and the loop turns its
+                               // estimate and splats into RGB
 };
 
 /// What the runtime hands an integrator.
@@ -129,6 +133,10 @@ struct PixelSample {
   uint32_t index = 0;      // sample index in the render's one sequence (split renders included)
   CameraSample camera;     // raster position (filter offset applied) and lens position
   const Ray* ray = nullptr;  // the camera ray; null when none leaves the lens
+  /// In a spectral render, the sample's wavelengths (drawn by the loop after the lens position):
+  /// sample() then returns, and splats, values at these wavelengths, which the loop turns into
+  /// RGB. Null in an RGB render.
+  const SampledWavelengths* wavelengths = nullptr;
 };
 
 /// A run of sample indices [first_index, first_index + count) rendered for every pixel.
@@ -170,6 +178,10 @@ class SampleIntegrator : public Integrator {
   virtual bool film_holds_estimate() const { return true; }
   /// The current estimate, when the film does not hold it.
   virtual ImageRgb estimate() const { return {}; }
+  /// Whether sample() handles PixelSample::wavelengths (converts emission with
+  /// SampledWavelengths::illuminant(), hands the wavelengths to the BSDFs' TextureEvalContext). A
+  /// spectral render with an integrator that does not is refused before it starts.
+  virtual bool supports_spectral() const { return false; }
 
   /// Checkpoints (penumbra render --checkpoint / --resume) are taken between passes. An integrator
   /// whose next passes depend on more than (pixel, index, seed) and what begin_render() computes
@@ -186,10 +198,12 @@ class PixelIntegrator : public SampleIntegrator {
  public:
   ~PixelIntegrator() override;
   Rgb sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink& splats) final {
-    return ps.ray ? Li(*ps.ray, sampler, scene) : Rgb(0.f);
+    return ps.ray ? Li(*ps.ray, ps.wavelengths, sampler, scene) : Rgb(0.f);
   }
-  /// Radiance arriving along the camera ray. Draw random numbers only from `sampler`.
-  virtual Rgb Li(const Ray& ray, Sampler& sampler, const Scene& scene) const = 0;
+  /// Radiance arriving along the camera ray: RGB, or in a spectral render (`wavelengths` not null)
+  /// its values at the wavelengths. Draw random numbers only from `sampler`.
+  virtual Rgb Li(const Ray& ray, const SampledWavelengths* wavelengths, Sampler& sampler,
+                 const Scene& scene) const = 0;
 };
 
 }  // namespace penumbra

@@ -54,6 +54,7 @@ class ParamSet {
   /// Replaces or adds a value without a location (command-line overrides).
   void set_int(const std::string& name, int v);
   void set_string(const std::string& name, const std::string& v);
+  void set_bool(const std::string& name, bool v);
 
   const Param* find(const std::string& name) const;
   bool has(const std::string& name) const { return find(name) != nullptr; }

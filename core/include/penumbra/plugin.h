@@ -43,13 +43,15 @@ struct CreateContext {
   bool reverse_orientation = false;
   const TextureTable* textures = nullptr;  // named textures defined so far (materials, textures)
   bool spectrum_texture = false;  // texture plugins: the directive asked for "spectrum" (else "float")
+  bool spectral = false;          // the render is spectral (penumbra/spectrum.h): materials evaluate
+                                  // their colours per hit (TexturedRgb::evaluate), constants included
 
   /// A texturable parameter: the named texture for `"texture NAME" "tex"`, else the float value
   /// (or the table's default). An undefined texture, or a spectrum texture where a float one is
   /// needed, is an error at the parameter.
   TexturedFloat float_input(const std::string& name) const;
-  /// Same for colours: an "rgb"/"spectrum" value or a spectrum texture.
-  TexturedRgb rgb_input(const std::string& name) const;
+  /// Same for colours: an "rgb"/"spectrum" value or a spectrum texture, of the given kind.
+  TexturedRgb rgb_input(const std::string& name, RgbKind kind = RgbKind::Albedo) const;
   /// float_input() or rgb_input() by the value type T (float or Rgb).
   template <typename T>
   typename TextureOf<T>::Input input(const std::string& name) const {

@@ -12,6 +12,9 @@
 #include <penumbra/color.h>
 #include <penumbra/math.h>
 #include <penumbra/object.h>
+#include <penumbra/spectrum.h>
+
+#include <cstdint>
 
 namespace penumbra {
 
@@ -23,6 +26,9 @@ struct TextureEvalContext {
   Vec2 uv{0.f};  // surface parameterisation
   Vec3 dpdx{0.f}, dpdy{0.f};  // change of p from one pixel to the next (x: right, y: down)
   float dudx = 0.f, dudy = 0.f, dvdx = 0.f, dvdy = 0.f;
+  /// The path's wavelengths in a spectral render (null in an RGB one): TexturedRgb then gives the
+  /// parameter's spectrum at them. Texture plugins are always evaluated in RGB.
+  const SampledWavelengths* wavelengths = nullptr;
 };
 
 class FloatTexture : public Object {
@@ -56,21 +62,35 @@ class TexturedFloat {
   const FloatTexture* texture_ = nullptr;
 };
 
-/// An RGB parameter that is a constant or a spectrum texture.
+/// What an RGB parameter is, which decides its spectrum in a spectral render.
+enum class RgbKind : uint8_t {
+  Albedo,     // a reflectance or transmittance: clamped to [0, 1], SampledWavelengths::albedo()
+  Unbounded,  // an index of refraction, absorption or scale: SampledWavelengths::unbounded()
+};
+
+/// An RGB parameter that is a constant or a spectrum texture. evaluate() gives linear RGB, or in a
+/// spectral render (ctx.wavelengths set) the parameter's spectrum at the path's wavelengths; a
+/// material whose constants are made into a BSDF once must therefore evaluate them per hit when
+/// CreateContext::spectral is set.
 class TexturedRgb {
  public:
   TexturedRgb() = default;
-  explicit TexturedRgb(Rgb value) : value_(value) {}
-  explicit TexturedRgb(const SpectrumTexture* texture) : texture_(texture) {}
+  explicit TexturedRgb(Rgb value, RgbKind kind = RgbKind::Albedo) : value_(value), kind_(kind) {}
+  explicit TexturedRgb(const SpectrumTexture* texture, RgbKind kind = RgbKind::Albedo)
+      : texture_(texture), kind_(kind) {}
   bool is_constant() const { return texture_ == nullptr; }
   Rgb constant() const { return value_; }
+  RgbKind kind() const { return kind_; }
   Rgb evaluate(const TextureEvalContext& ctx) const {
+    if (ctx.wavelengths) return evaluate_spectral(ctx);
     return texture_ ? texture_->evaluate(ctx) : value_;
   }
 
  private:
+  Rgb evaluate_spectral(const TextureEvalContext& ctx) const;
   Rgb value_{0.f};
   const SpectrumTexture* texture_ = nullptr;
+  RgbKind kind_ = RgbKind::Albedo;
 };
 
 /// The interface and parameter type of a texture of values T (float or Rgb), for plugins that

@@ -19,7 +19,11 @@
 //    Scene::transmittance(); Param::from_attribute.
 // 9: Shape::present() (alpha cut-outs on area lights).
 // 10: LightSampleContext::allow_incomplete_pdf; Light::li_density_depends_on_receiver().
-#define PENUMBRA_SDK_VERSION 10
+// 11: spectral transport: penumbra/spectrum.h (SampledWavelengths), RenderOptions::spectral,
+//     PixelSample::wavelengths, PixelIntegrator::Li takes the wavelengths,
+//     TextureEvalContext::wavelengths, TexturedRgb kinds (RgbKind), CreateContext::spectral,
+//     SampleIntegrator::supports_spectral(), ParamSet::set_bool.
+#define PENUMBRA_SDK_VERSION 11
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

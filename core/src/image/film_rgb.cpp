@@ -30,6 +30,8 @@ static const ParamSpec kFilmParams[] = {
     {"string", "filename", "penumbra.exr", "output image (.exr, .hdr, .tif, .png)"},
     {"string[]", "aovs", "", "auxiliary outputs written as EXR layers: albedo, normal, depth, samples, "
                              "variance, nonfinite or all (names or comma-separated lists)"},
+    {"bool", "spectral", "false", "spectral transport: three sampled wavelengths per pixel sample, colours as smooth "
+                                   "spectra (docs/spectral.md; path integrator)"},
     {"unsupported", "cropwindow", "", ""},
     {"unsupported", "pixelbounds", "", ""},
     {"unsupported", "diagonal", "", "Penumbra's film has no physical size"},

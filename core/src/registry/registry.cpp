@@ -151,6 +151,7 @@ Object* Registry::create_object(const LoadedPlugin& plugin, ParamSet& params, Cr
   full.reverse_orientation = ctx.reverse_orientation;
   full.textures = ctx.textures;
   full.spectrum_texture = ctx.spectrum_texture;
+  full.spectral = ctx.spectral;
   Object* obj = info.create(full);
   if (!obj) throw Error(loc, fmt::format("{} '{}' could not be created", plugin_kind_name(info.kind), info.name));
   return obj;

@@ -33,18 +33,22 @@ class CheckedSplats final : public SplatSink {
  public:
   CheckedSplats(RenderContext& ctx, Film& film) : ctx_(ctx), film_(film) {}
   void start(Point2i pixel) { pixel_ = pixel; }
+  /// The wavelengths of the sample whose splats follow (spectral renders), or null.
+  void set_wavelengths(const SampledWavelengths* w) { wavelengths_ = w; }
   void splat(const Vec2& p_raster, const Rgb& value) override {
     if (!is_finite(value)) {
       ctx_.report_nonfinite(pixel_);
       return;
     }
-    if (!is_black(value)) film_.add_splat(p_raster, value);
+    if (is_black(value)) return;
+    film_.add_splat(p_raster, wavelengths_ ? wavelengths_->to_rgb(value) : value);
   }
 
  private:
   RenderContext& ctx_;
   Film& film_;
   Point2i pixel_{0};
+  const SampledWavelengths* wavelengths_ = nullptr;
 };
 
 struct ThreadState {
@@ -64,6 +68,7 @@ void SampleIntegrator::render(RenderContext& ctx) {
   const uint64_t pixels = static_cast<uint64_t>(res.x) * res.y;
   const uint64_t total = pixels * static_cast<uint64_t>(opt.spp);
   const bool surface_aovs = film.wants_surface_samples();
+  const bool spectral = opt.spectral;
   begin_render(ctx);
   // The runtime's context takes checkpoints between passes and may resume from one.
   CheckpointHost* host = dynamic_cast<CheckpointHost*>(&ctx);
@@ -126,7 +131,14 @@ void SampleIntegrator::render(RenderContext& ctx) {
               ps.camera = CameraSample{Vec2(x + 0.5f, y + 0.5f) + fs.offset, sampler.get_2d()};
               std::optional<Ray> ray = camera.generate_ray(ps.camera);
               ps.ray = ray ? &*ray : nullptr;
+              SampledWavelengths wavelengths;
+              if (spectral) {
+                wavelengths = SampledWavelengths::sample(sampler.get_1d());
+                ps.wavelengths = &wavelengths;
+                ts.splats.set_wavelengths(&wavelengths);
+              }
               Rgb L = sample(scene, ps, sampler, ts.splats);
+              if (spectral) L = wavelengths.to_rgb(L);
               if (surface_aovs)
                 film.add_surface_sample(pixel, ray ? trace_surface_sample(scene, *ray, pixel, index) : SurfaceSample{},
                                         fs.weight);

@@ -369,6 +369,7 @@ RenderResult render(const RenderSettings& settings) {
     desc.sampler.params.set_int("pixelsamples", *settings.spp);
   }
   if (settings.seed) desc.sampler.params.set_int("seed", static_cast<int>(*settings.seed));
+  if (settings.spectral) desc.film.params.set_bool("spectral", true);
   if (settings.resolution) {
     desc.film.params.set_int("xresolution", settings.resolution->first);
     desc.film.params.set_int("yresolution", settings.resolution->second);
@@ -396,6 +397,17 @@ RenderResult render(const RenderSettings& settings) {
   options.time_budget = settings.time_budget;
   options.threads = threads;
   options.spp = built.sampler->samples_per_pixel();
+  options.spectral = built.spectral;
+  if (built.spectral) {
+    auto* si = dynamic_cast<const SampleIntegrator*>(built.integrator.get());
+    if (!si || !si->supports_spectral())
+      throw Error(desc.film.params.loc_of("spectral"),
+                  fmt::format("integrator '{}' does not support spectral transport yet (available: path)",
+                              built.integrator_name));
+    if (built.scene->has_media())
+      throw Error(desc.film.params.loc_of("spectral"),
+                  "spectral transport does not support participating media yet (their absorption is RGB)");
+  }
   if (settings.time_budget > 0.0 && !settings.spp) options.spp = INT_MAX;
   if (options.spp <= 0) throw Error(desc.sampler.params.loc_of("pixelsamples"), "pixelsamples must be positive");
   // Texture filter footprint as pbrt-v4 scales it, from the whole render's samples per pixel (the

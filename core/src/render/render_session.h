@@ -48,6 +48,7 @@ struct RenderSettings {
   double time_budget = 0.0;              // seconds, 0 = none
   int threads = 0;                       // 0 = all cores
   std::optional<uint32_t> seed;
+  bool spectral = false;                 // --spectral: the Film's "spectral" set to true
   std::string integrator;                // --integrator NAME
   std::string sampler;                   // --sampler NAME
   std::vector<ParamOverride> integrator_params;  // --param NAME=VALUE, applied after --integrator

@@ -271,6 +271,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
   if (res.x <= 0 || res.y <= 0 || res.x > 65536 || res.y > 65536)
     throw Error(desc.film.loc, fmt::format("film resolution {}x{} is out of range", res.x, res.y));
   out.output_filename = desc.film.params.get_string("filename");
+  out.spectral = desc.film.params.get_bool("spectral");
 
   std::string filter_type = desc.filter.type.empty() ? kDefaultFilter : desc.filter.type;
   if (pixel_filter_params(filter_type).empty())
@@ -325,6 +326,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     material_anisotropic.push_back(anisotropic(m.params));
     CreateContext ctx{m.params, {}, m.base_dir};
     ctx.textures = &out.texture_table;
+    ctx.spectral = out.spectral;
     out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, m.type, m.params, ctx, m.loc));
     // A bump map evaluates its texture over the pixel footprint too.
     material_textured.push_back(uses_textures(m.params) || material_detail.back().bump);
@@ -374,8 +376,9 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       return out.bsdfs[it->second].get();
     }
     if (!default_bsdf) {
-      out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, kDefaultMaterial, default_params,
-                                                CreateContext{default_params}, s.loc));
+      CreateContext ctx{default_params};
+      ctx.spectral = out.spectral;
+      out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, kDefaultMaterial, default_params, ctx, s.loc));
       default_bsdf = out.bsdfs.back().get();
     }
     return default_bsdf;
@@ -387,7 +390,9 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     p.add(Param{"rgb", "color", loc, {m.base_color.r, m.base_color.g, m.base_color.b}, {}, {}});
     p.add(Param{"float", "metallic", loc, {m.metallic}, {}, {}});
     p.add(Param{"float", "roughness", loc, {m.roughness}, {}, {}});
-    out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, "disney", p, CreateContext{p}, loc));
+    CreateContext ctx{p};
+    ctx.spectral = out.spectral;
+    out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, "disney", p, ctx, loc));
     return out.bsdfs.back().get();
   };
 

@@ -37,6 +37,7 @@ struct BuiltScene {
   std::unique_ptr<Integrator> integrator;
   std::string integrator_name, sampler_name;
   std::string output_filename;         // Film "filename"
+  bool spectral = false;               // Film "spectral": materials were made for spectral transport
   std::vector<std::string> structures_built;
 };
 

@@ -58,19 +58,34 @@ TexturedFloat CreateContext::float_input(const std::string& name) const {
   return TexturedFloat(params.get_float(name));
 }
 
-TexturedRgb CreateContext::rgb_input(const std::string& name) const {
+TexturedRgb CreateContext::rgb_input(const std::string& name, RgbKind kind) const {
   const Param* p = params.find(name);
   if (p && p->type == "texture") {
     const SpectrumTexture* t = textures ? textures->find_spectrum(p->strings[0]) : nullptr;
     if (!t) missing_texture(textures, *p, true);
-    return TexturedRgb(t);
+    return TexturedRgb(t, kind);
   }
   if (p && p->type != "rgb" && p->type != "spectrum")
     throw Error(p->loc, fmt::format("parameter '{}' needs an rgb value or a spectrum texture, not '{}'", name, p->type));
   // A one-number default ("1" in a texture plugin's table) stands for grey.
   std::vector<float> v = params.get_floats(name);
-  if (v.size() == 1) return TexturedRgb(Rgb(v[0]));
-  return TexturedRgb(params.get_rgb(name));
+  if (v.size() == 1) return TexturedRgb(Rgb(v[0]), kind);
+  return TexturedRgb(params.get_rgb(name), kind);
+}
+
+}  // namespace penumbra
+
+namespace penumbra {
+
+// Textures compute colours; the parameter that reads them turns the colour into a spectrum.
+Rgb TexturedRgb::evaluate_spectral(const TextureEvalContext& ctx) const {
+  Rgb rgb = value_;
+  if (texture_) {
+    TextureEvalContext rgb_ctx = ctx;
+    rgb_ctx.wavelengths = nullptr;
+    rgb = texture_->evaluate(rgb_ctx);
+  }
+  return kind_ == RgbKind::Albedo ? ctx.wavelengths->albedo(rgb) : ctx.wavelengths->unbounded(rgb);
 }
 
 }  // namespace penumbra

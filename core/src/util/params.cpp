@@ -38,6 +38,15 @@ void ParamSet::set_int(const std::string& name, int v) {
   p->numbers = {static_cast<double>(v)};
 }
 
+void ParamSet::set_bool(const std::string& name, bool v) {
+  Param* p = find_in(params_, name);
+  if (!p) { params_.push_back(Param{"bool", name, {}, {}, {}, {}}); p = &params_.back(); }
+  p->type = "bool";
+  p->numbers.clear();
+  p->strings.clear();
+  p->bools = {v};
+}
+
 void ParamSet::set_string(const std::string& name, const std::string& v) {
   Param* p = find_in(params_, name);
   if (!p) { params_.push_back(Param{"string", name, {}, {}, {}, {}}); p = &params_.back(); }

@@ -105,8 +105,8 @@ Object* create(const CreateContext& ctx) {
   in.interface_rough = prefixed_roughness(ctx, "interface.");
   in.conductor_rough = prefixed_roughness(ctx, "conductor.");
   in.interface_eta = checked_eta(p, "interface.eta");
-  in.eta = ctx.rgb_input("conductor.eta");
-  in.k = ctx.rgb_input("conductor.k");
+  in.eta = ctx.rgb_input("conductor.eta", RgbKind::Unbounded);
+  in.k = ctx.rgb_input("conductor.k", RgbKind::Unbounded);
   if (p.has("reflectance")) {
     in.reflectance = ctx.rgb_input("reflectance");
     if (in.reflectance->is_constant()) {
@@ -120,7 +120,7 @@ Object* create(const CreateContext& ctx) {
   if (in.k.is_constant() && !glm::all(glm::greaterThanEqual(in.k.constant(), Rgb(0.f))))
     throw Error(p.loc_of("conductor.k"), "conductor.k must be >= 0 in every channel");
   in.layer = layer_inputs(ctx);
-  if (!in.is_constant()) return new TexturedCoatedConductorBsdf(std::move(in));
+  if (!in.is_constant() || ctx.spectral) return new TexturedCoatedConductorBsdf(std::move(in));
   return new CoatedConductorBsdf(in.at({}));
 }
 

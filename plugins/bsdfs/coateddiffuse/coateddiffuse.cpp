@@ -76,7 +76,7 @@ Object* create(const CreateContext& ctx) {
   float eta = checked_eta(ps, "eta");
   MicrofacetRoughness rough = prefixed_roughness(ctx, "");
   LayerInputs layer = layer_inputs(ctx);
-  if (!reflectance.is_constant() || !rough.is_constant() || !layer.is_constant())
+  if (!reflectance.is_constant() || !rough.is_constant() || !layer.is_constant() || ctx.spectral)
     return new TexturedCoatedDiffuseBsdf(reflectance, rough, eta, layer);
   return new CoatedDiffuseBsdf(CoatedDiffuseBxdf(DielectricBxdf(eta, rough.at({})), DiffuseBxdf(reflectance.constant()),
                                                  layer.at({})));

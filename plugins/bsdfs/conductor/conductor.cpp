@@ -69,7 +69,7 @@ Object* create(const CreateContext& ctx) {
   if (p.has("reflectance") && (p.has("eta") || p.has("k")))
     throw Error(p.loc_of("reflectance"), "give either reflectance or eta and k, not both");
   MicrofacetRoughness rough = microfacet_roughness(ctx);
-  TexturedRgb eta_in = ctx.rgb_input("eta"), k_in = ctx.rgb_input("k");
+  TexturedRgb eta_in = ctx.rgb_input("eta", RgbKind::Unbounded), k_in = ctx.rgb_input("k", RgbKind::Unbounded);
   std::optional<TexturedRgb> refl_in;
   if (p.has("reflectance")) refl_in = ctx.rgb_input("reflectance");
   if (!rough.is_constant() || !eta_in.is_constant() || !k_in.is_constant() || (refl_in && !refl_in->is_constant()))
@@ -89,6 +89,7 @@ Object* create(const CreateContext& ctx) {
   if (!(eta.r > 0.f && eta.g > 0.f && eta.b > 0.f))
     throw Error(p.loc_of("eta"), "eta must be > 0 in every channel");
   if (!(k.r >= 0.f && k.g >= 0.f && k.b >= 0.f)) throw Error(p.loc_of("k"), "k must be >= 0 in every channel");
+  if (ctx.spectral) return new TexturedConductorBsdf(rough, eta_in, k_in, refl_in);  // spectra per path
   return new ConductorBsdf(ConductorBxdf(TrowbridgeReitz(ur, vr), eta, k));
 }
 

@@ -41,6 +41,7 @@ Object* create(const CreateContext& ctx) {
   Rgb r = tex.constant();
   if (!(r.r >= 0.f && r.g >= 0.f && r.b >= 0.f && r.r <= 1.f && r.g <= 1.f && r.b <= 1.f))
     throw Error(ctx.params.loc_of("reflectance"), "reflectance must be in [0, 1] (energy would not be conserved)");
+  if (ctx.spectral) return new TexturedDiffuseBsdf(tex);  // the spectrum at each path's wavelengths
   return new DiffuseBsdf(bxdf::DiffuseBxdf(r));
 }
 

@@ -102,6 +102,7 @@ Object* create(const CreateContext& ctx) {
   auto in_unit = [](Rgb c) { return c.r >= 0.f && c.g >= 0.f && c.b >= 0.f && c.r <= 1.f && c.g <= 1.f && c.b <= 1.f; };
   if (!in_unit(r)) throw Error(p.loc_of("reflectance"), "scale * reflectance must be in [0, 1]");
   if (!in_unit(t)) throw Error(p.loc_of("transmittance"), "scale * transmittance must be in [0, 1]");
+  if (ctx.spectral) return new TexturedDiffuseTransmissionBsdf(r_tex, t_tex, scale);  // spectra per path
   return new DiffuseTransmissionBsdf(r, t);
 }
 

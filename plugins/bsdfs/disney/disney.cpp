@@ -131,6 +131,9 @@ bool any_textured(const ParamSet& ps) {
 
 Object* create(const CreateContext& ctx) {
   const ParamSet& ps = ctx.params;
+  // Its tints are made from the colour's RGB luminance; spectral Disney would need them made before
+  // the colour becomes a spectrum (docs/spectral.md).
+  if (ctx.spectral) throw Error(ctx.loc, "material 'disney' does not support spectral transport yet");
   if (any_textured(ps)) {
     // Constants are still checked; the textured ones take their defaults here and vary per hit.
     disney::DisneyParams base;

@@ -30,7 +30,7 @@ enum class ColourInput { SigmaA, Reflectance, Melanin };
 class HairBsdf final : public Bsdf {
  public:
   HairBsdf(ColourInput input, TexturedRgb colour, TexturedFloat eumelanin, TexturedFloat pheomelanin, TexturedFloat eta,
-           TexturedFloat beta_m, TexturedFloat beta_n, TexturedFloat alpha)
+           TexturedFloat beta_m, TexturedFloat beta_n, TexturedFloat alpha, bool spectral)
       : input_(input),
         colour_(colour),
         eumelanin_(eumelanin),
@@ -46,7 +46,8 @@ class HairBsdf final : public Bsdf {
       constant_lobes_ = lobes(none);
     bool colour_constant = input == ColourInput::Melanin ? eumelanin.is_constant() && pheomelanin.is_constant()
                                                          : colour.is_constant();
-    if (colour_constant && (input != ColourInput::Reflectance || beta_n.is_constant()))
+    // (In a spectral render the absorption is a spectrum at each path's wavelengths.)
+    if (colour_constant && (input != ColourInput::Reflectance || beta_n.is_constant()) && !spectral)
       constant_sigma_a_ = sigma_a(none);
   }
 
@@ -76,7 +77,8 @@ class HairBsdf final : public Bsdf {
       case ColourInput::Reflectance: return sigma_a_from_reflectance(colour_.evaluate(t), beta_n(t));
       case ColourInput::Melanin: break;
     }
-    return sigma_a_from_concentration(std::max(0.f, eumelanin_.evaluate(t)), std::max(0.f, pheomelanin_.evaluate(t)));
+    Rgb s = sigma_a_from_concentration(std::max(0.f, eumelanin_.evaluate(t)), std::max(0.f, pheomelanin_.evaluate(t)));
+    return t.wavelengths ? t.wavelengths->unbounded(s) : s;  // pbrt-v4: the RGB absorptions as spectra
   }
 
   HairBxdf at(const ShadingContext& ctx) const {
@@ -121,7 +123,7 @@ Object* create(const CreateContext& ctx) {
   TexturedFloat eu(1.3f), pheo(0.f);
   if (p.has("sigma_a")) {
     input = ColourInput::SigmaA;
-    colour = ctx.rgb_input("sigma_a");
+    colour = ctx.rgb_input("sigma_a", RgbKind::Unbounded);
     if (colour.is_constant() && !(glm::all(glm::greaterThanEqual(colour.constant(), Rgb(0.f)))))
       throw Error(p.loc_of("sigma_a"), "sigma_a must be >= 0");
   } else if (p.has("reflectance")) {
@@ -136,7 +138,7 @@ Object* create(const CreateContext& ctx) {
     eu = p.has("eumelanin") ? ctx.float_input("eumelanin") : TexturedFloat(0.f);
     pheo = p.has("pheomelanin") ? ctx.float_input("pheomelanin") : TexturedFloat(0.f);
   }
-  return new HairBsdf(input, colour, eu, pheo, eta, beta_m, beta_n, alpha);
+  return new HairBsdf(input, colour, eu, pheo, eta, beta_m, beta_n, alpha, ctx.spectral);
 }
 
 }  // namespace

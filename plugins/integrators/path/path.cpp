@@ -29,7 +29,12 @@ class PathIntegrator final : public PixelIntegrator {
   PathIntegrator(int max_depth, int rr_depth, bool light_sampling)
       : max_depth_(max_depth), rr_depth_(rr_depth), light_sampling_(light_sampling) {}
 
-  Rgb Li(const Ray& camera_ray, Sampler& sampler, const Scene& scene) const override {
+  bool supports_spectral() const override { return true; }
+
+  Rgb Li(const Ray& camera_ray, const SampledWavelengths* wavelengths, Sampler& sampler,
+         const Scene& scene) const override {
+    // Emitted radiance at the path's wavelengths in a spectral render, RGB otherwise.
+    auto emitted = [wavelengths](const Rgb& Le) { return wavelengths ? wavelengths->illuminant(Le) : Le; };
     Rgb L(0.f), beta(1.f);
     Ray ray = camera_ray;
     bool specular_bounce = false;
@@ -49,6 +54,7 @@ class PathIntegrator final : public PixelIntegrator {
         for (const Light* light : scene.infinite_lights()) {
           Rgb Le = light->Le(ray);
           if (is_black(Le)) continue;
+          Le = emitted(Le);
           if (depth == 0 || specular_bounce || !light_sampling_) {
             L += beta * Le;
           } else {
@@ -64,6 +70,7 @@ class PathIntegrator final : public PixelIntegrator {
       if (si->area_light) {
         Rgb Le = si->area_light->L(si->p, si->ng, si->uv, si->wo);
         if (!is_black(Le)) {
+          Le = emitted(Le);
           if (depth == 0 || specular_bounce || !light_sampling_) {
             L += beta * Le;
           } else {
@@ -77,6 +84,7 @@ class PathIntegrator final : public PixelIntegrator {
       const Bsdf& bsdf = *si->bsdf;
       Vec3 wo = si->shading.to_local(si->wo);
       ShadingContext sctx{si->texture_context(), TransportMode::Radiance};
+      sctx.tex.wavelengths = wavelengths;
 
       // Next-event estimation (the dimensions are drawn even when unused). A BSDF with delta lobes
       // among others (Disney's mirror on a diffuse base) gets it through f() and pdf() of the others;
@@ -84,7 +92,7 @@ class PathIntegrator final : public PixelIntegrator {
       float u_light = sampler.get_1d();
       Vec2 u_light_point = sampler.get_2d();
       if (light_sampling_ && bsdf.flags() != 0 && !bsdf.is_specular_only())
-        L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point, medium);
+        L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point, medium, wavelengths);
 
       // Continue the path by sampling the BSDF.
       float u_lobe = sampler.get_1d();
@@ -119,7 +127,8 @@ class PathIntegrator final : public PixelIntegrator {
 
  private:
   Rgb sample_direct(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
-                    const Scene& scene, float u_light, Vec2 u, int arrived_in) const {
+                    const Scene& scene, float u_light, Vec2 u, int arrived_in,
+                    const SampledWavelengths* wavelengths) const {
     std::optional<SampledLight> sl = scene.sample_light(u_light);
     if (!sl) return Rgb(0.f);
     LightSampleContext lctx = mis_light_context(si);
@@ -134,10 +143,11 @@ class PathIntegrator final : public PixelIntegrator {
     if (scene.has_media())
       f *= scene.segment_transmittance(si.media.leaving(si.ng, ls->wi, arrived_in), kMediumUnknown,
                                        glm::length(ls->p_light - si.p));
+    Rgb Li = wavelengths ? wavelengths->illuminant(ls->L) : ls->L;
     float light_pdf = sl->pmf * ls->pdf;
-    if (is_delta_light(sl->light->type())) return f * ls->L / light_pdf;
+    if (is_delta_light(sl->light->type())) return f * Li / light_pdf;
     float w = power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
-    return f * ls->L * w / light_pdf;
+    return f * Li * w / light_pdf;
   }
 
   int max_depth_, rr_depth_;
