@@ -74,7 +74,7 @@ TEST(SpectralRender, WhatDoesNotSupportItYetIsRefusedBeforeRendering) {
   for (const char* integrator : {"bdpt", "lighttracing", "sppm"}) {
     CommandResult r = run_penumbra({"render", file, "--spectral", "--integrator", integrator, "-o", dir + "/x.exr"});
     EXPECT_EQ(r.exit_code, 1) << integrator;
-    EXPECT_THAT(r.err, ::testing::HasSubstr(std::string("integrator '") + integrator +
+    EXPECT_THAT(r.err, ::testing::HasSubstr(std::string("--spectral: integrator '") + integrator +
                                             "' does not support spectral transport yet"));
   }
   std::string disney = write_file(dir, "disney.pbrt", sphere_scene("Material \"disney\""));

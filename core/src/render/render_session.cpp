@@ -399,14 +399,17 @@ RenderResult render(const RenderSettings& settings) {
   options.spp = built.sampler->samples_per_pixel();
   options.spectral = built.spectral;
   if (built.spectral) {
+    // Asked for on the command line, the complaint names the option; from the scene, its line.
+    auto refuse = [&](const std::string& why) {
+      if (settings.spectral) return Error("--spectral: " + why);
+      return Error(desc.film.params.loc_of("spectral"), why);
+    };
     auto* si = dynamic_cast<const SampleIntegrator*>(built.integrator.get());
     if (!si || !si->supports_spectral())
-      throw Error(desc.film.params.loc_of("spectral"),
-                  fmt::format("integrator '{}' does not support spectral transport yet (available: path)",
-                              built.integrator_name));
+      throw refuse(fmt::format("integrator '{}' does not support spectral transport yet (available: path)",
+                               built.integrator_name));
     if (built.scene->has_media())
-      throw Error(desc.film.params.loc_of("spectral"),
-                  "spectral transport does not support participating media yet (their absorption is RGB)");
+      throw refuse("spectral transport does not support participating media yet (their absorption is RGB)");
   }
   if (settings.time_budget > 0.0 && !settings.spp) options.spp = INT_MAX;
   if (options.spp <= 0) throw Error(desc.sampler.params.loc_of("pixelsamples"), "pixelsamples must be positive");
