@@ -246,7 +246,7 @@ Shape "trianglemesh" "point3 P" [ -1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1
     std::vector<double> flux(max_depth, 0.0);
     for (int k = 0; k < n; ++k) {
       Pcg32 rng = photon_rng(9, 0, k);
-      trace_photon(scene, rng, max_depth, [&](const SurfaceInteraction&, const Vec3&, const Rgb& beta, int depth) {
+      trace_photon(scene, rng, max_depth, nullptr, [&](const SurfaceInteraction&, const Vec3&, const Rgb& beta, int depth) {
         flux[depth] += luminance(beta);
       });
     }

@@ -18,6 +18,11 @@ bool consistent_sides(const SurfaceInteraction& si, const Vec3& wo_local, const 
   return reflect_shading == reflect_geometric;
 }
 
+// Emitted radiance at the path's wavelengths in a spectral render, RGB otherwise.
+Rgb emitted(const SampledWavelengths* wavelengths, const Rgb& Le) {
+  return wavelengths ? wavelengths->illuminant(Le) : Le;
+}
+
 struct DirectSamples {
   float u_light;
   Vec2 u_light_point;
@@ -27,14 +32,14 @@ struct DirectSamples {
 
 // The infinite lights a BSDF-sampled ray that escapes the scene sees, weighted against light sampling.
 Rgb escaped_light(const Scene& scene, const Ray& ray, const LightSampleContext& lctx, const Vec3& wi,
-                  const Rgb& weight, float bsdf_pdf) {
+                  const Rgb& weight, float bsdf_pdf, const SampledWavelengths* wavelengths) {
   Rgb L(0.f);
   SurfaceInteraction none;
   for (const Light* light : scene.infinite_lights()) {
     Rgb Le = light->Le(ray);
     if (is_black(Le)) continue;
     float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, none);
-    L += weight * Le * power_heuristic(1, bsdf_pdf, 1, light_pdf);
+    L += weight * emitted(wavelengths, Le) * power_heuristic(1, bsdf_pdf, 1, light_pdf);
   }
   return L;
 }
@@ -43,7 +48,8 @@ Rgb escaped_light(const Scene& scene, const Ray& ray, const LightSampleContext& 
 // (power heuristic); the BSDF ray counts any emitter it finds, whose light-sampling density is
 // pmf(light) * pdf_li, exactly as in the path integrator.
 Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf, const ShadingContext& sctx,
-                 const Scene& scene, const DirectSamples& u, RaysFind rays_find, int arrived_in) {
+                 const Scene& scene, const DirectSamples& u, RaysFind rays_find, int arrived_in,
+                 const SampledWavelengths* wavelengths) {
   Rgb L(0.f);
   LightSampleContext lctx = mis_light_context(si);
   if (std::optional<SampledLight> sl = scene.sample_light(u.u_light)) {
@@ -58,7 +64,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
                                            glm::length(ls->p_light - si.p));
         float light_pdf = sl->pmf * ls->pdf;
         float w = is_delta_light(sl->light->type()) ? 1.f : power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
-        L += f * ls->L * w / light_pdf;
+        L += f * emitted(wavelengths, ls->L) * w / light_pdf;
       }
     }
   }
@@ -78,7 +84,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
   // (an any-hit query, and no hit record to build).
   if (rays_find == RaysFind::Environment) {
     if (scene.occluded(ray)) return L;
-    return L + escaped_light(scene, ray, lctx, wi, weight, bs->pdf);
+    return L + escaped_light(scene, ray, lctx, wi, weight, bs->pdf, wavelengths);
   }
   std::optional<SurfaceInteraction> hit = scene.intersect(ray);
   if (scene.has_media())
@@ -90,11 +96,11 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
       Rgb Le = light->L(hit->p, hit->ng, hit->uv, hit->wo);
       if (!is_black(Le)) {
         float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, *hit);
-        L += weight * Le * power_heuristic(1, bs->pdf, 1, light_pdf);
+        L += weight * emitted(wavelengths, Le) * power_heuristic(1, bs->pdf, 1, light_pdf);
       }
     }
   } else {
-    L += escaped_light(scene, ray, lctx, wi, weight, bs->pdf);
+    L += escaped_light(scene, ray, lctx, wi, weight, bs->pdf, wavelengths);
   }
   return L;
 }
@@ -126,7 +132,7 @@ RaysFind what_rays_find(const Scene& scene) {
 }
 
 CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth,
-                                   RaysFind rays_find) {
+                                   RaysFind rays_find, const SampledWavelengths* wavelengths) {
   CameraPathResult out;
   Ray ray = camera_ray;
   float distance = 0.f;
@@ -148,10 +154,11 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     bool count_emission = depth == 0 || specular_bounce;
     if (!si) {
       if (count_emission)
-        for (const Light* light : scene.infinite_lights()) out.Ld += beta * light->Le(ray);
+        for (const Light* light : scene.infinite_lights()) out.Ld += beta * emitted(wavelengths, light->Le(ray));
       break;
     }
-    if (si->area_light && count_emission) out.Ld += beta * si->area_light->L(si->p, si->ng, si->uv, si->wo);
+    if (si->area_light && count_emission)
+      out.Ld += beta * emitted(wavelengths, si->area_light->L(si->p, si->ng, si->uv, si->wo));
     distance += glm::length(si->p - ray.o);
     if (depth == max_depth) break;
 
@@ -164,7 +171,9 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     if (flags == 0) break;
     Vec3 wo = si->shading.to_local(si->wo);
     ShadingContext sctx{si->texture_context(), TransportMode::Radiance};
-    if (!bsdf.is_specular_only()) out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find, medium);
+    sctx.tex.wavelengths = wavelengths;
+    if (!bsdf.is_specular_only())
+      out.Ld += beta * direct_light(*si, wo, bsdf, sctx, scene, du, rays_find, medium, wavelengths);
 
     // The continuation; a BSDF with diffuse and delta lobes needs it for the decision below.
     const bool diffuse = flags & BsdfDiffuse, has_delta = flags & BsdfSpecular;
@@ -182,7 +191,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
       if (depth + 1 < max_depth) {
         Rgb vp_beta = beta;
         if (has_delta) vp_beta *= float(draws_until_not_specular(bsdf, wo, sctx, sampler));
-        out.vp = VisiblePoint{si->shading, wo, si->texture_context(), &bsdf, vp_beta, max_depth - 1 - depth};
+        out.vp = VisiblePoint{si->shading, wo, sctx.tex, &bsdf, vp_beta, max_depth - 1 - depth};
         out.p = si->p;
         out.distance = distance;
       }

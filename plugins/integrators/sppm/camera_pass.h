@@ -7,6 +7,7 @@
 #include <penumbra/camera.h>
 #include <penumbra/sampler.h>
 #include <penumbra/scene.h>
+#include <penumbra/spectrum.h>
 
 namespace penumbra::sppm {
 
@@ -30,8 +31,11 @@ struct CameraPathResult {
 /// or not so that quasi-random samplers keep their dimensions aligned across paths. A visible point
 /// on a BSDF with delta and diffuse lobes draws 3 more per extra BSDF sample after the last bounce's.
 /// `rays_find` is what_rays_find(scene): which emitters a BSDF-sampled direct-light ray can find.
+/// In a spectral render `wavelengths` are the iteration's: Ld and the visible point's throughput are
+/// then values at those wavelengths (null: RGB).
 CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sampler& sampler, int max_depth,
-                                   RaysFind rays_find = RaysFind::Anything);
+                                   RaysFind rays_find = RaysFind::Anything,
+                                   const SampledWavelengths* wavelengths = nullptr);
 
 /// Which emitters a ray can find in `scene`.
 RaysFind what_rays_find(const Scene& scene);

@@ -5,6 +5,7 @@
 #include <penumbra/bsdf.h>
 #include <penumbra/rng.h>
 #include <penumbra/scene.h>
+#include <penumbra/spectrum.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -22,9 +23,11 @@ inline Pcg32 photon_rng(uint64_t seed, uint64_t iteration, uint64_t index) {
 /// at every hit on a surface that can scatter non-specularly (no visible point lies on a mirror or
 /// clear glass, so hits there carry nothing to gather). wi points back along the photon; beta is the
 /// photon's flux weight, whose expectation at depth d is the power that arrives after d bounces.
-/// Depth 0 is the light's own direct illumination.
+/// Depth 0 is the light's own direct illumination. In a spectral render beta holds the flux at
+/// `wavelengths` (the iteration's); null: RGB.
 template <class Deposit>
-void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& deposit) {
+void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, const SampledWavelengths* wavelengths,
+                  Deposit&& deposit) {
   float u_light = rng.next_float();
   Vec2 u_pos(rng.next_float(), rng.next_float());
   Vec2 u_dir(rng.next_float(), rng.next_float());
@@ -35,7 +38,8 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& depos
   // Points, spots and infinite lights have no surface at the origin: their L already is what
   // leaves along the ray (intensity, or radiance over the disk the ray starts on).
   float cos = le->n == Vec3(0.f) ? 1.f : std::abs(glm::dot(le->n, glm::normalize(le->ray.d)));
-  Rgb beta = le->L * cos / (sl->pmf * le->pdf_pos * le->pdf_dir);
+  Rgb L = wavelengths ? wavelengths->illuminant(le->L) : le->L;
+  Rgb beta = L * cos / (sl->pmf * le->pdf_pos * le->pdf_dir);
   if (!is_finite(beta) || is_black(beta)) return;
 
   Ray ray = le->ray;
@@ -61,6 +65,7 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& depos
     Vec2 u = Vec2(rng.next_float(), rng.next_float());
     float u_rr = rng.next_float();
     ShadingContext sctx{si->texture_context(), TransportMode::Importance};
+    sctx.tex.wavelengths = wavelengths;
     Vec3 wo = si->shading.to_local(si->wo);
     std::optional<BsdfSample> bs = bsdf.sample_f(wo, u_lobe, u, sctx);
     if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) return;
@@ -72,8 +77,11 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, Deposit&& depos
     Rgb beta_new = beta * bs->f * std::abs(bs->wi.z) / bs->pdf;
 
     // Survive with probability lum(beta_new) / lum(beta), then divide: surviving photons keep about
-    // the weight they had, so the deposits of one pass have similar magnitudes.
-    float lum = luminance(beta), lum_new = luminance(beta_new);
+    // the weight they had, so the deposits of one pass have similar magnitudes. Values at three
+    // wavelengths have no luminance weights (a flux left at the wavelength weighted 0.07 would
+    // survive rarely and then carry 14 times its weight): there the largest value plays its part.
+    auto weight = [wavelengths](const Rgb& b) { return wavelengths ? max_component(b) : luminance(b); };
+    float lum = weight(beta), lum_new = weight(beta_new);
     if (!(lum > 0.f) || !(lum_new > 0.f) || !is_finite(beta_new)) return;
     float q = std::max(0.f, 1.f - lum_new / lum);
     if (u_rr < q) return;

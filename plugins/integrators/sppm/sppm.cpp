@@ -22,6 +22,12 @@
 // so it cannot be accumulated in the film pass by pass: it goes to the film once, at the end, and a
 // snapshot after an iteration asks the integrator for the current estimate instead.
 //
+// Spectral renders (docs/spectral.md): as in pbrt-v4, one set of wavelengths per iteration, shared
+// by every camera path and photon of it, so a photon's flux and a visible point's throughput are
+// values at the same wavelengths; the iteration's camera-side light and photon sums are turned into
+// RGB when the iteration ends. The wavelengths' number is a base-2 radical inverse of the
+// iteration, rotated by the photon seed, so iterations stratify the spectrum.
+//
 // Depth: a photon gathered at a visible point found after d camera bounces has made at most
 // maxdepth - 1 - d bounces, so the image converges to exactly what "path" renders with the same
 // maxdepth (pbrt lets photons add up to maxdepth - 1 bounces whatever d is).
@@ -89,7 +95,10 @@ class SppmIntegrator final : public SampleIntegrator {
   bool film_holds_estimate() const override { return false; }
   ImageRgb estimate() const override;
 
+  bool supports_spectral() const override { return true; }
+
   void begin_render(RenderContext& ctx) override;
+  void begin_pass(RenderContext& ctx, const Pass& pass) override;
   Rgb sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink&) override;
   void end_pass(RenderContext& ctx, const Pass& pass) override;
   void end_render(RenderContext& ctx, int spp) override;
@@ -115,6 +124,8 @@ class SppmIntegrator final : public SampleIntegrator {
   double quantum_ = 1.0, inv_quantum_ = 1.0;
   bool trace_photons_ = false;
   RaysFind rays_find_ = RaysFind::Anything;  // what a BSDF-sampled direct-light ray can find
+  bool spectral_ = false;
+  SampledWavelengths lambda_;       // the iteration's wavelengths (spectral renders)
   std::vector<VisiblePoint> vps_;
   std::vector<Vec3> vp_p_;
   std::vector<float> vp_radius_;    // 0 where a pixel has no visible point this iteration
@@ -157,6 +168,7 @@ void SppmIntegrator::begin_render(RenderContext& ctx) {
   // One bounce is all direct light; photons start to matter from two.
   trace_photons_ = max_depth_ >= 2 && photons_ > 0 && total_power > 0.0;
   rays_find_ = what_rays_find(scene);
+  spectral_ = ctx.options().spectral;
   // Per-pixel state, announced before it is allocated: the visible point and its split-out position,
   // radius and direct light, the statistics, the photon accumulator, the footprint, one gather point
   // and, per point in the grid, a 16-byte entry, its index, its bucket and up to 8 bytes of bucket table.
@@ -178,6 +190,22 @@ void SppmIntegrator::begin_render(RenderContext& ctx) {
   emitted_ = 0.0;
 }
 
+// Van der Corput's radical inverse in base 2 of i, in [0, 1).
+float radical_inverse_2(uint32_t i) {
+  i = (i << 16) | (i >> 16);
+  i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+  i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+  i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+  i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+  return static_cast<float>(i >> 8) * 0x1p-24f;
+}
+
+void SppmIntegrator::begin_pass(RenderContext&, const Pass& pass) {
+  if (!spectral_) return;
+  float u = radical_inverse_2(pass.first_index) + static_cast<float>(photon_stream_ >> 40) * 0x1p-24f;
+  lambda_ = SampledWavelengths::sample(u >= 1.f ? u - 1.f : u);
+}
+
 // Camera pass: every pixel's state is written by the one thread that renders its sample.
 Rgb SppmIntegrator::sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink&) {
   size_t i = static_cast<size_t>(ps.pixel.y) * res_.x + ps.pixel.x;
@@ -185,8 +213,9 @@ Rgb SppmIntegrator::sample(const Scene& scene, const PixelSample& ps, Sampler& s
   vp_radius_[i] = 0.f;
   vp_Ld_[i] = Rgb(0.f);
   if (!ps.ray) return Rgb(0.f);
-  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_, rays_find_);
-  vp_Ld_[i] = r.Ld;
+  const SampledWavelengths* lambda = spectral_ ? &lambda_ : nullptr;
+  CameraPathResult r = trace_camera_path(scene, *ps.ray, sampler, max_depth_, rays_find_, lambda);
+  vp_Ld_[i] = spectral_ ? lambda_.to_rgb(r.Ld) : r.Ld;
   bool valid = r.vp.bsdf && is_finite(r.p) && is_finite(r.vp.beta) && !is_black(r.vp.beta);
   if (!valid) return Rgb(0.f);
   vps_[i] = r.vp;
@@ -237,6 +266,7 @@ void SppmIntegrator::build_gather_points() {
 // Batches of photons, so a time budget that runs out stops the pass within one batch per thread.
 void SppmIntegrator::photon_pass(RenderContext& ctx, uint32_t iteration) {
   const Scene& scene = ctx.scene();
+  const SampledWavelengths* lambda = spectral_ ? &lambda_ : nullptr;
   std::atomic<uint64_t> traced{0};
   const uint64_t batches = (photons_ + kPhotonBatch - 1) / kPhotonBatch;
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, batches, 1), [&](const tbb::blocked_range<uint64_t>& b) {
@@ -245,7 +275,7 @@ void SppmIntegrator::photon_pass(RenderContext& ctx, uint32_t iteration) {
       uint64_t k0 = batch * kPhotonBatch, k1 = std::min(photons_, k0 + kPhotonBatch);
       for (uint64_t k = k0; k < k1; ++k) {
         Pcg32 rng = photon_rng(photon_stream_, iteration, k);
-        trace_photon(scene, rng, max_depth_, [&](const SurfaceInteraction& hit, const Vec3& wi, const Rgb& beta, int depth) {
+        trace_photon(scene, rng, max_depth_, lambda, [&](const SurfaceInteraction& hit, const Vec3& wi, const Rgb& beta, int depth) {
           if (depth == 0) return;  // direct light: the camera pass sampled it
           auto gather = [&](uint32_t slot) {
             const GatherPoint& g = gather_[slot];
@@ -253,6 +283,7 @@ void SppmIntegrator::photon_pass(RenderContext& ctx, uint32_t iteration) {
             ShadingContext sc;
             if (g.textured) sc.tex = vps_[grid_.point_of(slot)].tex;
             else sc.tex.uv = g.uv;
+            sc.tex.wavelengths = lambda;
             Rgb phi = beta * g.bsdf->f(g.wo, g.shading.to_local(wi), sc);
             if (!is_finite(phi)) {
               uint32_t i = grid_.point_of(slot);
@@ -328,6 +359,10 @@ void SppmIntegrator::end_pass(RenderContext& ctx, const Pass& pass) {
         double Phi[3];
         for (int c = 0; c < 3; ++c)
           Phi[c] = static_cast<double>(acc.phi[c].load(std::memory_order_relaxed)) * quantum_ * vps_[i].beta[c];
+        if (spectral_) {  // values at the iteration's wavelengths, in double until the conversion
+          Rgb rgb = lambda_.to_rgb(Rgb(static_cast<float>(Phi[0]), static_cast<float>(Phi[1]), static_cast<float>(Phi[2])));
+          for (int c = 0; c < 3; ++c) Phi[c] = rgb[c];
+        }
         update_statistics(stats_[i], static_cast<double>(M), Phi, alpha_);
         acc.reset();
       }
