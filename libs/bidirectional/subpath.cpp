@@ -45,7 +45,8 @@ Ray shadow_ray(const Vertex& v, const Vec3& p1, const Vec3& n1) {
 }
 
 // Fills `v` in place (a returned vertex was built and then copied, 272 bytes, at every bounce).
-void make_surface_vertex(Vertex& v, const SurfaceInteraction& si, const Rgb& beta, TransportMode mode) {
+void make_surface_vertex(Vertex& v, const SurfaceInteraction& si, const Rgb& beta, TransportMode mode,
+                         const SampledWavelengths* wavelengths) {
   v = Vertex{};
   v.kind = VertexKind::Surface;
   v.p = si.p;
@@ -54,6 +55,7 @@ void make_surface_vertex(Vertex& v, const SurfaceInteraction& si, const Rgb& bet
   v.ns = si.ns;
   v.shading = si.shading;
   v.sc.tex = si.texture_context();
+  v.sc.tex.wavelengths = wavelengths;
   v.wo = si.wo;
   v.wo_local = si.shading.to_local(si.wo);
   v.bsdf = si.bsdf;
@@ -113,7 +115,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
       beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
     }
     if (si) {
-      make_surface_vertex(v, *si, beta, mode);
+      make_surface_vertex(v, *si, beta, mode, ctx.wavelengths);
       v.medium = static_cast<int16_t>(medium);
       v.w_prev_local = v.shading.to_local(direction_to(v, prev));
     } else if (mode == TransportMode::Radiance && !scene.infinite_lights().empty()) {
@@ -396,7 +398,7 @@ int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
   y0.sc.mode = TransportMode::Importance;
 
   float cos0 = le->n != Vec3(0.f) ? std::abs(glm::dot(le->n, le->ray.d)) : 1.f;
-  Rgb beta = le->L * cos0 / (sl->pmf * le->pdf_pos * le->pdf_dir);
+  Rgb beta = ctx.emitted(le->L) * cos0 / (sl->pmf * le->pdf_pos * le->pdf_dir);
   int n = random_walk(ctx, le->ray, ps, beta, TransportMode::Importance, path, ctx.config.max_depth);
   y0.pdf_fwd = pdf_light_origin(ctx, y0, n > 0 ? path[1] : y0);
   // The same for every connection with s >= 2 (x_0 and x_1 are this path's): once per path.
@@ -649,7 +651,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     if (pt.kind == VertexKind::Light) {
       // Each environment light is its own strategy family: weight it with its own densities.
       for (const Light* env : scene.infinite_lights()) {
-        Rgb Le = env->Le(Ray{camera[t - 2].p, -pt.w_light});
+        Rgb Le = ctx.emitted(env->Le(Ray{camera[t - 2].p, -pt.w_light}));
         if (is_black(Le)) continue;
         Vertex end = pt;
         end.light = env;
@@ -661,7 +663,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       return c;
     }
     if (!pt.light) return c;
-    c.L = pt.beta * pt.light->L(pt.p, pt.ng, pt.sc.tex.uv, direction_to(pt, camera[t - 2]));
+    c.L = pt.beta * ctx.emitted(pt.light->L(pt.p, pt.ng, pt.sc.tex.uv, direction_to(pt, camera[t - 2])));
     finish(nullptr, nullptr);
     return c;
   }
@@ -687,7 +689,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     if (qs.kind == VertexKind::Surface)
       c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
     else  // a point on an area light seen directly (light tracing's s = 1)
-      c.L = qs.beta * qs.light->L(qs.p, qs.ng, qs.sc.tex.uv, cw->wi) * std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
+      c.L = qs.beta * ctx.emitted(qs.light->L(qs.p, qs.ng, qs.sc.tex.uv, cw->wi)) * std::abs(glm::dot(cw->wi, qs.ng)) *
+            cam.beta;
     if (scene.has_media())
       c.L *= scene.segment_transmittance(medium_side(qs, cw->wi), kMediumUnknown, glm::length(cam.p - qs.p));
     if (is_black(c.L) || scene.occluded(shadow_ray(qs, cam.p, Vec3(0.f)))) {
@@ -729,7 +732,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     lv.ng = ls->n_light;
     lv.infinite = is_at_infinity(sl->light);
     lv.w_light = -ls->wi;
-    lv.beta = ls->L / (ls->pdf * sl->pmf);
+    lv.beta = ctx.emitted(ls->L) / (ls->pdf * sl->pmf);
     lv.sc.mode = TransportMode::Importance;
     // Both emission densities of the sampled point from one pdf_le() call (pdf_light_origin() and
     // pdf_light_dir() towards pt).

@@ -133,9 +133,9 @@ struct PixelSample {
   uint32_t index = 0;      // sample index in the render's one sequence (split renders included)
   CameraSample camera;     // raster position (filter offset applied) and lens position
   const Ray* ray = nullptr;  // the camera ray; null when none leaves the lens
-  /// In a spectral render, the sample's wavelengths (drawn by the loop after the lens position):
-  /// sample() then returns, and splats, values at these wavelengths, which the loop turns into
-  /// RGB. Null in an RGB render.
+  /// In a spectral render, the sample's wavelengths (drawn by the loop after the lens position, or
+  /// the pass's: see wavelengths_per_pass()): sample() then returns, and splats, values at these
+  /// wavelengths, which the loop turns into RGB. Null in an RGB render.
   const SampledWavelengths* wavelengths = nullptr;
 };
 
@@ -144,6 +144,9 @@ struct Pass {
   uint32_t first_index = 0;
   int count = 1;
   bool complete = true;    // end_pass(): false when the time budget cut the pass short
+  /// A spectral render's one set of wavelengths for every sample of this pass, when the integrator
+  /// asks for it (wavelengths_per_pass()); null otherwise. Valid until end_pass() returns.
+  const SampledWavelengths* wavelengths = nullptr;
 };
 
 /// Base for every integrator that renders pixel samples: the core's render loop. Passes of samples
@@ -182,6 +185,12 @@ class SampleIntegrator : public Integrator {
   /// SampledWavelengths::illuminant(), hands the wavelengths to the BSDFs' TextureEvalContext). A
   /// spectral render with an integrator that does not is refused before it starts.
   virtual bool supports_spectral() const { return false; }
+  /// True when every sample of a pass must share one set of wavelengths (asked after
+  /// begin_render()): work prepared for the whole pass (a photon pass, a light-vertex cache) meets
+  /// the pixels' paths, and values at different wavelengths cannot be multiplied. The loop then
+  /// draws them once per pass (Pass::wavelengths, also PixelSample::wavelengths), stratified over
+  /// passes by a radical inverse of the pass's first index; false: each sample draws its own.
+  virtual bool wavelengths_per_pass() const { return false; }
 
   /// Checkpoints (penumbra render --checkpoint / --resume) are taken between passes. An integrator
   /// whose next passes depend on more than (pixel, index, seed) and what begin_render() computes

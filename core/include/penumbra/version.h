@@ -23,7 +23,8 @@
 //     PixelSample::wavelengths, PixelIntegrator::Li takes the wavelengths,
 //     TextureEvalContext::wavelengths, TexturedRgb kinds (RgbKind), CreateContext::spectral,
 //     SampleIntegrator::supports_spectral(), ParamSet::set_bool.
-#define PENUMBRA_SDK_VERSION 11
+// 12: SampleIntegrator::wavelengths_per_pass(), Pass::wavelengths.
+#define PENUMBRA_SDK_VERSION 12
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

@@ -58,6 +58,30 @@ struct ThreadState {
 
 }  // namespace
 
+namespace {
+
+// Per-pass wavelengths: the base-2 radical inverse of the pass's first sample index, rotated (mod 1)
+// by a number that follows the seed, so that passes stratify the spectrum and seeds differ.
+float pass_wavelength_number(uint32_t first_index, float rotation) {
+  uint32_t i = first_index;
+  i = (i << 16) | (i >> 16);
+  i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+  i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+  i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+  i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+  float u = static_cast<float>(i >> 8) * 0x1p-24f + rotation;
+  return u >= 1.f ? u - 1.f : u;
+}
+
+// The rotation: a number of the prototype sampler at a sample index no render reaches.
+float wavelength_rotation_of(const Sampler& prototype) {
+  std::unique_ptr<Sampler> s = prototype.clone();
+  s->start_pixel_sample(Point2i(0, 0), 0xffffffe0u);
+  return std::min(s->get_1d(), OneMinusEpsilon);
+}
+
+}  // namespace
+
 void SampleIntegrator::render(RenderContext& ctx) {
   const Scene& scene = ctx.scene();
   Film& film = ctx.film();
@@ -70,6 +94,8 @@ void SampleIntegrator::render(RenderContext& ctx) {
   const bool surface_aovs = film.wants_surface_samples();
   const bool spectral = opt.spectral;
   begin_render(ctx);
+  const bool per_pass_wavelengths = spectral && wavelengths_per_pass();
+  const float wavelength_rotation = per_pass_wavelengths ? wavelength_rotation_of(ctx.sampler()) : 0.f;
   // The runtime's context takes checkpoints between passes and may resume from one.
   CheckpointHost* host = dynamic_cast<CheckpointHost*>(&ctx);
   std::optional<ResumePoint> resumed = host ? host->resume(*this) : std::nullopt;
@@ -104,6 +130,11 @@ void SampleIntegrator::render(RenderContext& ctx) {
     Pass pass;
     pass.first_index = static_cast<uint32_t>(opt.first_sample + done_spp);
     pass.count = std::min({opt.spp - done_spp, pass_spp, max_pass});
+    SampledWavelengths pass_wavelengths;
+    if (per_pass_wavelengths) {
+      pass_wavelengths = SampledWavelengths::sample(pass_wavelength_number(pass.first_index, wavelength_rotation));
+      pass.wavelengths = &pass_wavelengths;
+    }
     double pass_start = ctx.elapsed();
     begin_pass(ctx, pass);
     std::atomic<bool> cut{false};
@@ -133,7 +164,10 @@ void SampleIntegrator::render(RenderContext& ctx) {
               ps.ray = ray ? &*ray : nullptr;
               SampledWavelengths wavelengths;
               if (spectral) {
-                wavelengths = SampledWavelengths::sample(sampler.get_1d());
+                // Drawn in either case, so the sampler's dimensions do not depend on the choice.
+                float u = sampler.get_1d();
+                if (per_pass_wavelengths) wavelengths = pass_wavelengths;
+                else wavelengths = SampledWavelengths::sample(u);
                 ps.wavelengths = &wavelengths;
                 ts.splats.set_wavelengths(&wavelengths);
               }

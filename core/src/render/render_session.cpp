@@ -406,7 +406,7 @@ RenderResult render(const RenderSettings& settings) {
     };
     auto* si = dynamic_cast<const SampleIntegrator*>(built.integrator.get());
     if (!si || !si->supports_spectral())
-      throw refuse(fmt::format("integrator '{}' does not support spectral transport yet (available: path, sppm)",
+      throw refuse(fmt::format("integrator '{}' does not support spectral transport yet (available: path, bdpt, lighttracing, sppm)",
                                built.integrator_name));
     if (built.scene->has_media())
       throw refuse("spectral transport does not support participating media yet (their absorption is RGB)");

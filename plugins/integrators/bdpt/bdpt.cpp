@@ -41,6 +41,10 @@
 // sample every path (emission hits, s = 0, are always on; without nextevent and lighttrace, paths
 // from delta lights are lost).
 //
+// Spectral renders (docs/spectral.md): a sample's subpaths and connections carry values at its
+// wavelengths. With a light-vertex cache the loop gives every sample of an iteration the same
+// wavelengths (wavelengths_per_pass()), at which the cache's light subpaths are traced too.
+//
 // The strategy images are <prefix>d<depth>_s<s>_t<t>.exr (weighted: they sum to the image when the
 // filter is a box), ..._unweighted.exr (each alone estimates the depth-d image, where the strategy can
 // sample it) and ..._weight.exr (mean weight over the samples the strategy found light with).
@@ -202,19 +206,29 @@ class BdptIntegrator final : public SampleIntegrator {
 
   // With a light-vertex cache, a pass is one iteration: one sample per pixel over one cache.
   int max_pass_samples() const override { return cached_ ? 1 : 16; }
+  bool supports_spectral() const override { return true; }
+  bool wavelengths_per_pass() const override { return cached_ != nullptr; }
 
   void begin_pass(RenderContext& rc, const Pass& pass) override {
     // Cut short when the time budget runs out; the loop then renders no tile of this pass.
-    if (cached_) cached_->begin_iteration(*ctx_, rc.sampler(), res_, pass.first_index, [&rc] { return rc.should_stop(); });
+    if (cached_) {
+      Context pass_ctx = *ctx_;
+      pass_ctx.wavelengths = pass.wavelengths;
+      cached_->begin_iteration(pass_ctx, rc.sampler(), res_, pass.first_index, [&rc] { return rc.should_stop(); });
+    }
   }
 
   Rgb sample(const Scene& scene, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
     const int max_depth = config_.max_depth;
     if (!px.ray) return Rgb(0.f);
+    // The sample's wavelengths go with the context (a copy: the shared one stays RGB).
+    Context spectral_ctx = *ctx_;
+    spectral_ctx.wavelengths = px.wavelengths;
+    const Context& ctx = px.wavelengths ? spectral_ctx : *ctx_;
     SubpathStorage<0> camera_path(max_depth + 2);
     SubpathStorage<1> own_light_path(max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);
-    int nc = camera_subpath(*ctx_, *px.ray, ps, camera_path.data());
+    int nc = camera_subpath(ctx, *px.ray, ps, camera_path.data());
     // The pixel's light subpath: from the iteration's cache when it holds it (the same path).
     size_t j = static_cast<size_t>(px.pixel.y) * res_.x + px.pixel.x;
     const Vertex* light_path = own_light_path.data();
@@ -223,7 +237,7 @@ class BdptIntegrator final : public SampleIntegrator {
       light_path = cached_->cache().path(j);
       nl = cached_->cache().path_length(j);
     } else {
-      nl = light_subpath(*ctx_, ps, own_light_path.data());
+      nl = light_subpath(ctx, ps, own_light_path.data());
     }
     StrategyImages* images = visualize_ ? &images_->local() : nullptr;
     // Strategies whose connection would end at a vertex that cannot be connected (specular-only, an
@@ -249,7 +263,7 @@ class BdptIntegrator final : public SampleIntegrator {
         if (s == 0 ? !has(emitter, t - 1)
                    : (t >= 2 && !has(camera_ok, t - 1)) || ((s >= 2 || t == 1) && !has(light_ok, s - 1)))
           continue;
-        Connection c = connect(*ctx_, light_path, s, camera_path.data(), t, ps);
+        Connection c = connect(ctx, light_path, s, camera_path.data(), t, ps);
         if (is_black(c.L)) continue;
         if (c.splat)
           splats.splat(c.p_raster, c.weighted);
@@ -261,7 +275,7 @@ class BdptIntegrator final : public SampleIntegrator {
       }
     if (cached_)
       for (int t = 2; t <= nc; ++t)
-        cached_->connect_eye_vertex(*ctx_, camera_path.data(), t, px.pixel, px.index,
+        cached_->connect_eye_vertex(ctx, camera_path.data(), t, px.pixel, px.index,
                                     [&](const Connection& c, int) { L += c.weighted; });
     return L;
   }

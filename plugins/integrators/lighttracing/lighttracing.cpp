@@ -36,12 +36,18 @@ class LightTracingIntegrator final : public SampleIntegrator {
     ctx_ = std::make_unique<Context>(Context{rc.scene(), *chooser_, config_});
   }
 
+  // Spectral renders: the light subpath carries values at the sample's wavelengths, which the loop
+  // turns into RGB as it splats them.
+  bool supports_spectral() const override { return true; }
+
   Rgb sample(const Scene&, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
     SubpathStorage<0> light_path(config_.max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);
-    int nl = light_subpath(*ctx_, ps, light_path.data());
+    Context ctx = *ctx_;
+    ctx.wavelengths = px.wavelengths;
+    int nl = light_subpath(ctx, ps, light_path.data());
     for (int s = 1; s <= nl; ++s) {
-      Connection c = connect(*ctx_, light_path.data(), s, &lens_, 1, ps, /*weighted=*/false);
+      Connection c = connect(ctx, light_path.data(), s, &lens_, 1, ps, /*weighted=*/false);
       if (c.splat && !is_black(c.L)) splats.splat(c.p_raster, c.L);
     }
     return Rgb(0.f);

@@ -23,10 +23,9 @@
 // snapshot after an iteration asks the integrator for the current estimate instead.
 //
 // Spectral renders (docs/spectral.md): as in pbrt-v4, one set of wavelengths per iteration, shared
-// by every camera path and photon of it, so a photon's flux and a visible point's throughput are
-// values at the same wavelengths; the iteration's camera-side light and photon sums are turned into
-// RGB when the iteration ends. The wavelengths' number is a base-2 radical inverse of the
-// iteration, rotated by the photon seed, so iterations stratify the spectrum.
+// by every camera path and photon of it (the loop's per-pass wavelengths), so a photon's flux and a
+// visible point's throughput are values at the same wavelengths; the iteration's camera-side light
+// and photon sums are turned into RGB when the iteration ends.
 //
 // Depth: a photon gathered at a visible point found after d camera bounces has made at most
 // maxdepth - 1 - d bounces, so the image converges to exactly what "path" renders with the same
@@ -96,6 +95,7 @@ class SppmIntegrator final : public SampleIntegrator {
   ImageRgb estimate() const override;
 
   bool supports_spectral() const override { return true; }
+  bool wavelengths_per_pass() const override { return true; }
 
   void begin_render(RenderContext& ctx) override;
   void begin_pass(RenderContext& ctx, const Pass& pass) override;
@@ -125,7 +125,7 @@ class SppmIntegrator final : public SampleIntegrator {
   bool trace_photons_ = false;
   RaysFind rays_find_ = RaysFind::Anything;  // what a BSDF-sampled direct-light ray can find
   bool spectral_ = false;
-  SampledWavelengths lambda_;       // the iteration's wavelengths (spectral renders)
+  SampledWavelengths lambda_;       // the iteration's wavelengths (spectral renders: Pass::wavelengths)
   std::vector<VisiblePoint> vps_;
   std::vector<Vec3> vp_p_;
   std::vector<float> vp_radius_;    // 0 where a pixel has no visible point this iteration
@@ -190,20 +190,9 @@ void SppmIntegrator::begin_render(RenderContext& ctx) {
   emitted_ = 0.0;
 }
 
-// Van der Corput's radical inverse in base 2 of i, in [0, 1).
-float radical_inverse_2(uint32_t i) {
-  i = (i << 16) | (i >> 16);
-  i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
-  i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
-  i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
-  i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
-  return static_cast<float>(i >> 8) * 0x1p-24f;
-}
-
+// The iteration's wavelengths, kept where the visible points' lookup contexts can point to them.
 void SppmIntegrator::begin_pass(RenderContext&, const Pass& pass) {
-  if (!spectral_) return;
-  float u = radical_inverse_2(pass.first_index) + static_cast<float>(photon_stream_ >> 40) * 0x1p-24f;
-  lambda_ = SampledWavelengths::sample(u >= 1.f ? u - 1.f : u);
+  if (pass.wavelengths) lambda_ = *pass.wavelengths;
 }
 
 // Camera pass: every pixel's state is written by the one thread that renders its sample.
