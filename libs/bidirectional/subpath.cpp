@@ -112,7 +112,7 @@ int random_walk(const Context& ctx, Ray ray, PathSampler& ps, Rgb beta, Transpor
     int medium = kMediumUnknown;
     if (media) {  // absorption along the segment just traced
       medium = segment_medium(medium_side(prev, ray.d), si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
-      beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
+      beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity, ctx.wavelengths);
     }
     if (si) {
       make_surface_vertex(v, *si, beta, mode, ctx.wavelengths);
@@ -593,7 +593,8 @@ Rgb connect_surfaces(const Context& ctx, const Vertex* light, int s, const Verte
   Rgb L = qs.beta * surface_f(qs, w, wq) * surface_f(pt, -w, wp) * pt.beta;
   if (is_black(L)) return L;
   L *= std::abs(glm::dot(qs.ns, w)) * std::abs(glm::dot(pt.ns, w)) / dist2;
-  if (ctx.scene.has_media()) L *= ctx.scene.segment_transmittance(medium_side(qs, w), medium_side(pt, -w), dist);
+  if (ctx.scene.has_media())
+    L *= ctx.scene.segment_transmittance(medium_side(qs, w), medium_side(pt, -w), dist, ctx.wavelengths);
   if (is_black(L) ||
       ctx.scene.occluded(spawn_ray_to(qs.p, error_of(qs), qs.ng, pt.p, error_of(pt), pt.ng)))
     return Rgb(0.f);
@@ -692,7 +693,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       c.L = qs.beta * ctx.emitted(qs.light->L(qs.p, qs.ng, qs.sc.tex.uv, cw->wi)) * std::abs(glm::dot(cw->wi, qs.ng)) *
             cam.beta;
     if (scene.has_media())
-      c.L *= scene.segment_transmittance(medium_side(qs, cw->wi), kMediumUnknown, glm::length(cam.p - qs.p));
+      c.L *= scene.segment_transmittance(medium_side(qs, cw->wi), kMediumUnknown, glm::length(cam.p - qs.p),
+                                         ctx.wavelengths);
     if (is_black(c.L) || scene.occluded(shadow_ray(qs, cam.p, Vec3(0.f)))) {
       c.L = Rgb(0.f);
       return c;
@@ -752,7 +754,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     Vec3 wl = pt.shading.to_local(w);
     c.L = pt.beta * surface_f(pt, w, wl) * lv.beta * std::abs(glm::dot(ls->wi, pt.ns));
     if (scene.has_media())
-      c.L *= scene.segment_transmittance(medium_side(pt, ls->wi), kMediumUnknown, glm::length(ls->p_light - pt.p));
+      c.L *= scene.segment_transmittance(medium_side(pt, ls->wi), kMediumUnknown, glm::length(ls->p_light - pt.p),
+                                         ctx.wavelengths);
     if (is_black(c.L) || scene.occluded(shadow_ray(pt, ls->p_light, ls->n_light))) {
       c.L = Rgb(0.f);
       return c;

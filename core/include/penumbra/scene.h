@@ -46,12 +46,14 @@ class Scene {
   /// (integrators may skip all medium bookkeeping when not).
   virtual bool has_media() const { return false; }
   /// Beer-Lambert transmittance exp(-sigma_a distance) of medium `medium` (-1, vacuum: 1). An
-  /// infinite distance through an absorbing medium gives 0.
-  virtual Rgb transmittance(int medium, float distance) const;
+  /// infinite distance through an absorbing medium gives 0. In a spectral render, at `wavelengths`
+  /// (sigma_a as an unbounded spectrum); null: RGB.
+  virtual Rgb transmittance(int medium, float distance, const SampledWavelengths* wavelengths = nullptr) const;
   /// Transmittance of a segment between two ends (see segment_medium()).
-  Rgb segment_transmittance(int from_side, int to_side, float distance) const {
+  Rgb segment_transmittance(int from_side, int to_side, float distance,
+                            const SampledWavelengths* wavelengths = nullptr) const {
     int m = segment_medium(from_side, to_side);
-    return m < 0 ? Rgb(1.f) : transmittance(m, distance);
+    return m < 0 ? Rgb(1.f) : transmittance(m, distance, wavelengths);
   }
 };
 

@@ -408,8 +408,6 @@ RenderResult render(const RenderSettings& settings) {
     if (!si || !si->supports_spectral())
       throw refuse(fmt::format("integrator '{}' does not support spectral transport yet (available: path, bdpt, lighttracing, sppm)",
                                built.integrator_name));
-    if (built.scene->has_media())
-      throw refuse("spectral transport does not support participating media yet (their absorption is RGB)");
   }
   if (settings.time_budget > 0.0 && !settings.spp) options.spp = INT_MAX;
   if (options.spp <= 0) throw Error(desc.sampler.params.loc_of("pixelsamples"), "pixelsamples must be positive");

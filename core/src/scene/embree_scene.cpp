@@ -438,9 +438,9 @@ void EmbreeScene::add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu
   solve(si.dpdy, &si.dudy, &si.dvdy);
 }
 
-Rgb EmbreeScene::transmittance(int medium, float distance) const {
+Rgb EmbreeScene::transmittance(int medium, float distance, const SampledWavelengths* wavelengths) const {
   if (medium < 0) return Rgb(1.f);
-  const Rgb& sigma = media_sigma_a_[medium];
+  const Rgb sigma = wavelengths ? wavelengths->unbounded(media_sigma_a_[medium]) : media_sigma_a_[medium];
   auto channel = [&](float s) { return s == 0.f ? 1.f : std::exp(-s * distance); };  // 0 * inf is no absorption
   return Rgb(channel(sigma.r), channel(sigma.g), channel(sigma.b));
 }

@@ -64,7 +64,7 @@ class EmbreeScene final : public Scene {
   /// Absorption coefficients of the media that geometry names by index.
   void set_media(std::vector<Rgb> sigma_a) { media_sigma_a_ = std::move(sigma_a); }
   bool has_media() const override { return !media_sigma_a_.empty(); }
-  Rgb transmittance(int medium, float distance) const override;
+  Rgb transmittance(int medium, float distance, const SampledWavelengths* wavelengths) const override;
   /// Meshes and spheres kept for area lights to reference before commit().
   const TriangleMesh& mesh(size_t i) const { return *meshes_[i]; }
 

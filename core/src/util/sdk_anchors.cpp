@@ -26,7 +26,7 @@ Shape::~Shape() = default;
 Camera::~Camera() = default;
 Film::~Film() = default;
 Scene::~Scene() = default;
-Rgb Scene::transmittance(int, float) const { return Rgb(1.f); }
+Rgb Scene::transmittance(int, float, const SampledWavelengths*) const { return Rgb(1.f); }
 FloatTexture::~FloatTexture() = default;
 SpectrumTexture::~SpectrumTexture() = default;
 

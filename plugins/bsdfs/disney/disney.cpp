@@ -107,7 +107,12 @@ Object* create_textured(const CreateContext& ctx, const disney::DisneyParams& ba
   }
   auto params_at = [base, color, varying](const TextureEvalContext& tc) {
     disney::DisneyParams p = base;
-    p.color = glm::clamp(color.evaluate(tc), Rgb(0.f), Rgb(1.f));
+    // The colour in RGB even in a spectral render: DisneyBsdf makes its spectra after deriving
+    // the tints from it.
+    TextureEvalContext rgb_tc = tc;
+    rgb_tc.wavelengths = nullptr;
+    p.color = glm::clamp(color.evaluate(rgb_tc), Rgb(0.f), Rgb(1.f));
+    p.wavelengths = tc.wavelengths;
     for (const auto& [f, in] : varying) p.*(f.field) = std::clamp(in.evaluate(tc), 0.f, f.max);
     return p;
   };
@@ -123,6 +128,13 @@ Object* create_textured(const CreateContext& ctx, const disney::DisneyParams& ba
   return new disney::TexturedDisneyBsdf(params_at, flags);
 }
 
+Rgb checked_color(const ParamSet& ps) {
+  Rgb c = ps.get_rgb("color");
+  if (!(glm::all(glm::greaterThanEqual(c, Rgb(0.f))) && glm::all(glm::lessThanEqual(c, Rgb(1.f)))))
+    throw Error(ps.loc_of("color"), "color must be in [0, 1] (energy would not be conserved)");
+  return c;
+}
+
 bool any_textured(const ParamSet& ps) {
   for (const auto& p : ps.params())
     if (p.type == "texture") return true;
@@ -131,13 +143,11 @@ bool any_textured(const ParamSet& ps) {
 
 Object* create(const CreateContext& ctx) {
   const ParamSet& ps = ctx.params;
-  // Its tints are made from the colour's RGB luminance; spectral Disney would need them made before
-  // the colour becomes a spectrum (docs/spectral.md).
-  if (ctx.spectral) throw Error(ctx.loc, "material 'disney' does not support spectral transport yet");
-  if (any_textured(ps)) {
+  // Textured, or in a spectral render (whose colours are made per hit, at the path's wavelengths).
+  if (any_textured(ps) || ctx.spectral) {
     // Constants are still checked; the textured ones take their defaults here and vary per hit.
     disney::DisneyParams base;
-    if (ps.find("color") && ps.find("color")->type != "texture") base.color = ps.get_rgb("color");
+    if (ps.find("color") && ps.find("color")->type != "texture") base.color = checked_color(ps);
     for (const Fraction& f : kFractions) {
       const Param* given = ps.find(f.name);
       if (!given || given->type != "texture") base.*(f.field) = fraction(ps, f.name, static_cast<int>(f.max));
@@ -148,9 +158,7 @@ Object* create(const CreateContext& ctx) {
     return create_textured(ctx, base);
   }
   disney::DisneyParams p;
-  p.color = ps.get_rgb("color");
-  if (!(glm::all(glm::greaterThanEqual(p.color, Rgb(0.f))) && glm::all(glm::lessThanEqual(p.color, Rgb(1.f)))))
-    throw Error(ps.loc_of("color"), "color must be in [0, 1] (energy would not be conserved)");
+  p.color = checked_color(ps);
   p.metallic = fraction(ps, "metallic");
   p.eta = ps.get_float("eta");
   if (!(p.eta > 0.f && std::isfinite(p.eta))) throw Error(ps.loc_of("eta"), "eta must be positive");

@@ -26,9 +26,16 @@ float delta_alpha() { return TrowbridgeReitz(0.f, 0.f).alpha_x(); }
 }  // namespace
 
 DisneyBsdf::DisneyBsdf(const DisneyParams& p) : eta_(p.eta), thin_(p.thin) {
-  const Rgb& c = p.color;
-  float lum = luminance(c);
-  Rgb tint = lum > 0.f ? c / lum : Rgb(1.f);  // hue and saturation only
+  const Rgb& rgb = p.color;
+  float lum = luminance(rgb);
+  Rgb rgb_tint = lum > 0.f ? rgb / lum : Rgb(1.f);  // hue and saturation only
+  Rgb rgb_sqrt = glm::sqrt(rgb);
+  // In a spectral render, each derived colour's spectrum at the path's wavelengths (the tint can
+  // exceed 1: an unbounded value).
+  const SampledWavelengths* w = p.wavelengths;
+  const Rgb c = w ? w->albedo(rgb) : rgb;
+  const Rgb tint = w ? w->unbounded(rgb_tint) : rgb_tint;
+  const Rgb c_sqrt = w ? w->albedo(rgb_sqrt) : rgb_sqrt;
 
   // Diffuse family. Unlike pbrt-v3, retro-reflection and diffuse transmission are also scaled so
   // that reflected + transmitted diffuse keep the diffuse weight, and metals never transmit.
@@ -53,7 +60,7 @@ DisneyBsdf::DisneyBsdf(const DisneyParams& p) : eta_(p.eta), thin_(p.thin) {
   clearcoat_.r0 = p.clearcoat_r0;
 
   // sqrt(colour): light crossing two interfaces comes out with the base colour.
-  transmission_.tint = (1.f - p.metallic) * p.spec_trans * glm::sqrt(c);
+  transmission_.tint = (1.f - p.metallic) * p.spec_trans * c_sqrt;
   // Thin surfaces stand for two interfaces with one lobe: Burley 2015 fig. 15 widens it with eta.
   transmission_.distribution =
       p.thin ? disney_distribution((0.65f * p.eta - 0.35f) * p.roughness, aspect) : specular_.distribution;

@@ -42,6 +42,10 @@ struct DisneyParams {
   bool thin = false;
   float flatness = 0.f;
   float diff_trans = 1.f;      // thin only: 0 reflects all diffuse light, 2 transmits all
+  /// A spectral render's wavelengths at the hit, or null. The colours derived from `color` (its
+  /// tint, its square root) are made in RGB, as the model defines them, and each then becomes its
+  /// smooth spectrum at these wavelengths.
+  const SampledWavelengths* wavelengths = nullptr;
 };
 
 class DisneyBsdf final : public Bsdf {

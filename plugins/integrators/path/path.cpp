@@ -48,7 +48,7 @@ class PathIntegrator final : public PixelIntegrator {
       std::optional<SurfaceInteraction> si = scene.intersect(ray);
       if (media) {  // absorption along the segment just traced
         medium = segment_medium(medium, si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
-        beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
+        beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity, wavelengths);
       }
       if (!si) {
         for (const Light* light : scene.infinite_lights()) {
@@ -142,7 +142,7 @@ class PathIntegrator final : public PixelIntegrator {
     if (scene.occluded(si.spawn_ray_to(ls->p_light, ls->n_light))) return Rgb(0.f);
     if (scene.has_media())
       f *= scene.segment_transmittance(si.media.leaving(si.ng, ls->wi, arrived_in), kMediumUnknown,
-                                       glm::length(ls->p_light - si.p));
+                                       glm::length(ls->p_light - si.p), wavelengths);
     Rgb Li = wavelengths ? wavelengths->illuminant(ls->L) : ls->L;
     float light_pdf = sl->pmf * ls->pdf;
     if (is_delta_light(sl->light->type())) return f * Li / light_pdf;

@@ -61,7 +61,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
           !scene.occluded(si.spawn_ray_to(ls->p_light, ls->n_light))) {
         if (scene.has_media())
           f *= scene.segment_transmittance(si.media.leaving(si.ng, ls->wi, arrived_in), kMediumUnknown,
-                                           glm::length(ls->p_light - si.p));
+                                           glm::length(ls->p_light - si.p), wavelengths);
         float light_pdf = sl->pmf * ls->pdf;
         float w = is_delta_light(sl->light->type()) ? 1.f : power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
         L += f * emitted(wavelengths, ls->L) * w / light_pdf;
@@ -90,7 +90,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
   if (scene.has_media())
     weight *= scene.segment_transmittance(si.media.leaving(si.ng, wi, arrived_in),
                                           hit ? hit->media.toward(hit->ng, -wi) : kMediumUnknown,
-                                          hit ? hit->t * glm::length(ray.d) : Infinity);
+                                          hit ? hit->t * glm::length(ray.d) : Infinity, wavelengths);
   if (hit) {
     if (const Light* light = hit->area_light) {
       Rgb Le = light->L(hit->p, hit->ng, hit->uv, hit->wo);
@@ -147,7 +147,7 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     std::optional<SurfaceInteraction> si = scene.intersect(ray);
     if (media) {
       medium = segment_medium(medium, si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
-      beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity);
+      beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity, wavelengths);
     }
     // Emission counts here only where direct lighting could not have found it: on the camera ray
     // and after specular bounces.

@@ -51,7 +51,7 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, const SampledWa
     if (!si) return;
     if (media) {  // absorption along the segment: the photon's flux weight falls
       medium = segment_medium(medium, si->media.toward(si->ng, -ray.d));
-      beta *= scene.transmittance(medium, si->t);
+      beta *= scene.transmittance(medium, si->t, wavelengths);
       if (is_black(beta)) return;
     }
     const Bsdf& bsdf = *si->bsdf;
