@@ -18,6 +18,8 @@
 #   --no-native     do not render Penumbra with the scene's own integrator (only with path)
 #   --out DIR       where the temporary scene copies and images go (default /tmp/penumbra-vs-pbrt-v4)
 #   --penumbra BIN  Penumbra binary (default: build/bin/penumbra of this checkout)
+#   --rgb           render Penumbra with RGB transport (its default) instead of spectral transport, which
+#                   this script uses by default because pbrt-v4 always renders spectrally
 #   --crop-top F    also compare the means of the images without their top fraction F (0 < F < 1): for
 #                   scenes whose mean is dominated by a tiny light seen directly (water-caustic: a few
 #                   camera samples per render hit it, so the full mean cannot agree at any practical spp)
@@ -36,7 +38,7 @@ set -u -o pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 pbrt="${PBRT:-}"
 if [[ $# -gt 0 && "$1" != -* && -x "$1" && ! -d "$1" && "$1" != *.pbrt ]]; then pbrt="$1"; shift; fi
-width=160 spp=64 threads=2 seed=1 noise=0 pbrtpath=0 native=1 croptop=""
+width=160 spp=64 threads=2 seed=1 noise=0 pbrtpath=0 native=1 croptop="" transport=(--spectral)
 out=/tmp/penumbra-vs-pbrt-v4
 penumbra="$here/build/bin/penumbra"
 scenes=()
@@ -52,6 +54,7 @@ while [[ $# -gt 0 ]]; do
     --out) out="$2"; shift 2 ;;
     --penumbra) penumbra="$2"; shift 2 ;;
     --crop-top) croptop="$2"; shift 2 ;;
+    --rgb) transport=(); shift ;;
     -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "unknown option $1" >&2; exit 2 ;;
     *) scenes+=("$1"); shift ;;
@@ -192,7 +195,8 @@ for entry in "${scenes[@]}"; do
   pathratio="-" nativeratio="-" noisepath="-" noisenative="-"
   for run in "${runs[@]}"; do
     img="$work/penumbra-$run.exr"; t0=$SECONDS
-    args=(render "$copy" -o "$img" --spp "$sspp" --res "${w}x${h}" --nthreads "$threads" --seed "$seed" -q)
+    args=(render "$copy" -o "$img" --spp "$sspp" --res "${w}x${h}" --nthreads "$threads" --seed "$seed" -q
+          ${transport[@]+"${transport[@]}"})
     [[ "$run" == path ]] && args+=(--integrator path --param "maxdepth=$maxdepth")
     runpen "$work/penumbra-$run.log" "${args[@]}"; rc=$?
     if [[ $rc -eq 0 ]]; then

@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false);
   render->add_option("--sampler", settings.sampler, "sampler plugin to use instead of the scene's");
   render->add_flag("--spectral", settings.spectral, "spectral transport: three sampled wavelengths per pixel "
-                   "sample, colours as smooth spectra, as pbrt-v4 renders (the Film's \"spectral\"; path)");
+                   "sample, colours as smooth spectra, as pbrt-v4 renders (the Film's \"spectral\")");
   render->add_option("--res", res, "image resolution WIDTHxHEIGHT");
   render->add_option("--stats", settings.stats_file, "write render statistics as JSON");
   render->add_flag("-q,--quiet", settings.quiet, "no progress output");

@@ -31,7 +31,7 @@ static const ParamSpec kFilmParams[] = {
     {"string[]", "aovs", "", "auxiliary outputs written as EXR layers: albedo, normal, depth, samples, "
                              "variance, nonfinite or all (names or comma-separated lists)"},
     {"bool", "spectral", "false", "spectral transport: three sampled wavelengths per pixel sample, colours as smooth "
-                                   "spectra (docs/spectral.md; path integrator)"},
+                                   "spectra (docs/spectral.md)"},
     {"unsupported", "cropwindow", "", ""},
     {"unsupported", "pixelbounds", "", ""},
     {"unsupported", "diagonal", "", "Penumbra's film has no physical size"},
