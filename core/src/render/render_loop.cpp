@@ -56,10 +56,6 @@ struct ThreadState {
   CheckedSplats splats;
 };
 
-}  // namespace
-
-namespace {
-
 // Per-pass wavelengths: the base-2 radical inverse of the pass's first sample index, rotated (mod 1)
 // by a number that follows the seed, so that passes stratify the spectrum and seeds differ.
 float pass_wavelength_number(uint32_t first_index, float rotation) {

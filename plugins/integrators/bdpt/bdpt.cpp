@@ -60,6 +60,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <map>
+#include <optional>
 
 namespace {
 
@@ -222,9 +223,12 @@ class BdptIntegrator final : public SampleIntegrator {
     const int max_depth = config_.max_depth;
     if (!px.ray) return Rgb(0.f);
     // The sample's wavelengths go with the context (a copy: the shared one stays RGB).
-    Context spectral_ctx = *ctx_;
-    spectral_ctx.wavelengths = px.wavelengths;
-    const Context& ctx = px.wavelengths ? spectral_ctx : *ctx_;
+    std::optional<Context> spectral_ctx;
+    if (px.wavelengths) {
+      spectral_ctx.emplace(*ctx_);
+      spectral_ctx->wavelengths = px.wavelengths;
+    }
+    const Context& ctx = spectral_ctx ? *spectral_ctx : *ctx_;
     SubpathStorage<0> camera_path(max_depth + 2);
     SubpathStorage<1> own_light_path(max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);
