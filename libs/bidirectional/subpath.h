@@ -130,8 +130,11 @@ Config read_subpath_config(const ParamSet& p, bool* uniform_lights);
 class PathSampler {
  public:
   PathSampler(Sampler& sampler, Point2i pixel, uint32_t index) : sampler_(sampler), pixel_(pixel), index_(index) {}
-  // Dimensions 0-3 are the film position and the lens, drawn by the render loop.
-  static constexpr uint32_t kLightChoice = 4, kLightPos = 5, kLightDir = 7, kLevels = 9, kPerLevel = 13;
+  // Dimensions 0-3 are the film position and the lens, 4 the wavelengths of a spectral render, all
+  // drawn by the render loop. (The light subpath once started at 4: in a spectral render the light
+  // choice then followed the wavelengths, and veach-bidir's two lights of different colours came out
+  // 13 % too dark in red.)
+  static constexpr uint32_t kLightChoice = 5, kLightPos = 6, kLightDir = 8, kLevels = 10, kPerLevel = 13;
   static uint32_t camera_bounce(int level) { return kLevels + kPerLevel * level; }       // 4: lobe, dir, roulette
   static uint32_t light_bounce(int level) { return kLevels + kPerLevel * level + 4; }    // 4
   static uint32_t next_event(int level) { return kLevels + kPerLevel * level + 8; }      // 3: light, point

@@ -4,6 +4,7 @@
 #include <penumbra/spectrum.h>
 
 #include <algorithm>
+#include <cstring>
 #include <vector>
 
 #include "spectra/rgb_to_spectrum_table.h"
@@ -53,6 +54,28 @@ T lerp_at(const std::vector<T>& table, float lambda) {
   return (1.f - f) * table[i] + f * table[i + 1];
 }
 
+// The coefficients of a reflectance colour. Colours repeat from hit to hit (a material's constant, a
+// light's emission), so each thread keeps the last colours it looked up, 16 slots chosen by a hash of
+// the colour's bits: a repeated colour costs a compare instead of the table's trilinear lookup.
+const spectra::SigmoidCoefficients& coefficients_of(const Rgb& rgb) {
+  struct Entry {
+    bool valid = false;
+    Rgb rgb{0.f};
+    spectra::SigmoidCoefficients c{};
+  };
+  thread_local Entry cache[16];
+  uint32_t bits[3];
+  std::memcpy(bits, &rgb, sizeof bits);
+  uint32_t h = (bits[0] * 0x9E3779B1u) ^ (bits[1] * 0x85EBCA77u) ^ (bits[2] * 0xC2B2AE3Du);
+  Entry& e = cache[h >> 28];
+  if (!e.valid || e.rgb != rgb) {
+    e.c = spectra::RgbToSpectrumTable::built_in()(rgb.r, rgb.g, rgb.b);
+    e.rgb = rgb;
+    e.valid = true;
+  }
+  return e.c;
+}
+
 }  // namespace
 
 SampledWavelengths SampledWavelengths::sample(float u) {
@@ -86,7 +109,7 @@ Rgb SampledWavelengths::to_rgb(const Rgb& L) const {
 }
 
 Rgb SampledWavelengths::albedo(const Rgb& rgb) const {
-  spectra::SigmoidCoefficients c = spectra::RgbToSpectrumTable::built_in()(rgb.r, rgb.g, rgb.b);
+  const spectra::SigmoidCoefficients& c = coefficients_of(rgb);
   return {spectra::sigmoid_spectrum(c, lambda_[0]), spectra::sigmoid_spectrum(c, lambda_[1]),
           spectra::sigmoid_spectrum(c, lambda_[2])};
 }
