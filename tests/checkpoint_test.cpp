@@ -69,18 +69,22 @@ struct Case {
   std::string integrator;
   int spp;       // long enough that a signal after the first checkpoint lands mid-render
   int signal;
+  bool spectral = false;  // per-sample wavelengths (path), or per-pass ones (sppm) that a resume must redraw alike
+  std::string name() const { return integrator + (spectral ? "_spectral" : ""); }
 };
 
 std::vector<std::string> render_args(const Case& c, const std::string& out, int threads) {
-  return {"render", kScene, "--integrator", c.integrator, "--spp", std::to_string(c.spp), "--res", "40x40",
-          "--threads", std::to_string(threads), "-o", out, "-q"};
+  std::vector<std::string> args = {"render", kScene, "--integrator", c.integrator, "--spp", std::to_string(c.spp),
+                                   "--res", "40x40", "--threads", std::to_string(threads), "-o", out, "-q"};
+  if (c.spectral) args.push_back("--spectral");
+  return args;
 }
 
 class Interrupt : public ::testing::TestWithParam<Case> {};
 
 TEST_P(Interrupt, ResumeGivesTheUninterruptedImageBitForBit) {
   Case c = GetParam();
-  std::string dir = test::temp_dir("interrupt-" + c.integrator);
+  std::string dir = test::temp_dir("interrupt-" + c.name());
   std::string full = dir + "/full.exr", part = dir + "/part.exr", ckpt = dir + "/part.ckpt";
   test::CommandResult ref = test::run_penumbra(render_args(c, full, 2));
   ASSERT_EQ(ref.exit_code, 0) << ref.err;
@@ -117,8 +121,9 @@ TEST_P(Interrupt, ResumeGivesTheUninterruptedImageBitForBit) {
 
 INSTANTIATE_TEST_SUITE_P(EveryIntegrator, Interrupt,
                          ::testing::Values(Case{"path", 1500, SIGINT}, Case{"bdpt", 300, SIGTERM},
-                                           Case{"lighttracing", 600, SIGINT}, Case{"sppm", 800, SIGTERM}),
-                         [](const auto& info) { return info.param.integrator; });
+                                           Case{"lighttracing", 600, SIGINT}, Case{"sppm", 800, SIGTERM},
+                                           Case{"path", 1500, SIGINT, true}, Case{"sppm", 800, SIGTERM, true}),
+                         [](const auto& info) { return info.param.name(); });
 
 TEST(Interrupt, SecondSignalExitsAtOnceWithoutWriting) {
   std::string dir = test::temp_dir("interrupt-twice");
