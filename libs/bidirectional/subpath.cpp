@@ -398,7 +398,7 @@ int light_subpath(const Context& ctx, PathSampler& ps, Vertex* path) {
   y0.sc.mode = TransportMode::Importance;
 
   float cos0 = le->n != Vec3(0.f) ? std::abs(glm::dot(le->n, le->ray.d)) : 1.f;
-  Rgb beta = ctx.emitted(le->L) * cos0 / (sl->pmf * le->pdf_pos * le->pdf_dir);
+  Rgb beta = emission_at(ctx.wavelengths, le->L) * cos0 / (sl->pmf * le->pdf_pos * le->pdf_dir);
   int n = random_walk(ctx, le->ray, ps, beta, TransportMode::Importance, path, ctx.config.max_depth);
   y0.pdf_fwd = pdf_light_origin(ctx, y0, n > 0 ? path[1] : y0);
   // The same for every connection with s >= 2 (x_0 and x_1 are this path's): once per path.
@@ -652,7 +652,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     if (pt.kind == VertexKind::Light) {
       // Each environment light is its own strategy family: weight it with its own densities.
       for (const Light* env : scene.infinite_lights()) {
-        Rgb Le = ctx.emitted(env->Le(Ray{camera[t - 2].p, -pt.w_light}));
+        Rgb Le = emission_at(ctx.wavelengths, env->Le(Ray{camera[t - 2].p, -pt.w_light}));
         if (is_black(Le)) continue;
         Vertex end = pt;
         end.light = env;
@@ -664,7 +664,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       return c;
     }
     if (!pt.light) return c;
-    c.L = pt.beta * ctx.emitted(pt.light->L(pt.p, pt.ng, pt.sc.tex.uv, direction_to(pt, camera[t - 2])));
+    Rgb Le = pt.light->L(pt.p, pt.ng, pt.sc.tex.uv, direction_to(pt, camera[t - 2]));
+    c.L = pt.beta * emission_at(ctx.wavelengths, Le);
     finish(nullptr, nullptr);
     return c;
   }
@@ -690,8 +691,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     if (qs.kind == VertexKind::Surface)
       c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
     else  // a point on an area light seen directly (light tracing's s = 1)
-      c.L = qs.beta * ctx.emitted(qs.light->L(qs.p, qs.ng, qs.sc.tex.uv, cw->wi)) * std::abs(glm::dot(cw->wi, qs.ng)) *
-            cam.beta;
+      c.L = qs.beta * emission_at(ctx.wavelengths, qs.light->L(qs.p, qs.ng, qs.sc.tex.uv, cw->wi)) *
+            std::abs(glm::dot(cw->wi, qs.ng)) * cam.beta;
     if (scene.has_media())
       c.L *= scene.segment_transmittance(medium_side(qs, cw->wi), kMediumUnknown, glm::length(cam.p - qs.p),
                                          ctx.wavelengths);
@@ -734,7 +735,7 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     lv.ng = ls->n_light;
     lv.infinite = is_at_infinity(sl->light);
     lv.w_light = -ls->wi;
-    lv.beta = ctx.emitted(ls->L) / (ls->pdf * sl->pmf);
+    lv.beta = emission_at(ctx.wavelengths, ls->L) / (ls->pdf * sl->pmf);
     lv.sc.mode = TransportMode::Importance;
     // Both emission densities of the sampled point from one pdf_le() call (pdf_light_origin() and
     // pdf_light_dir() towards pt).

@@ -185,9 +185,6 @@ struct Context {
   /// sample's, or the pass's for a light-vertex cache): throughputs and contributions are then
   /// values at them. Null: RGB.
   const SampledWavelengths* wavelengths = nullptr;
-
-  /// What a light emits, as the transport carries it: at the wavelengths, or RGB.
-  Rgb emitted(const Rgb& Le) const { return wavelengths ? wavelengths->illuminant(Le) : Le; }
 };
 
 /// Scratch storage for one subpath of `n` vertices, left uninitialised (the walks write every vertex

@@ -182,7 +182,7 @@ class SampleIntegrator : public Integrator {
   /// The current estimate, when the film does not hold it.
   virtual ImageRgb estimate() const { return {}; }
   /// Whether sample() handles PixelSample::wavelengths (converts emission with
-  /// SampledWavelengths::illuminant(), hands the wavelengths to the BSDFs' TextureEvalContext). A
+  /// emission_at() of penumbra/spectrum.h, hands the wavelengths to the BSDFs' TextureEvalContext). A
   /// spectral render with an integrator that does not is refused before it starts.
   virtual bool supports_spectral() const { return false; }
   /// True when every sample of a pass must share one set of wavelengths (asked after

@@ -8,7 +8,7 @@
 // Plugins meet this only through SampledWavelengths: the render loop hands one to each pixel
 // sample (PixelSample::wavelengths, null in an RGB render), textures see it in TextureEvalContext
 // (TexturedRgb converts on evaluation), and integrators convert what lights emit with
-// illuminant().
+// emission_at() (which calls illuminant() when there are wavelengths).
 #pragma once
 
 #include <penumbra/color.h>
@@ -43,5 +43,12 @@ class SampledWavelengths {
   float lambda_[3] = {0.f, 0.f, 0.f};
   float pdf_[3] = {0.f, 0.f, 0.f};
 };
+
+/// What a light emits (RGB radiance or intensity, as Light returns it) as the transport carries it:
+/// its illuminant spectrum at `wavelengths` in a spectral render, the RGB itself when they are null.
+/// Integrators call this wherever emission enters a path.
+inline Rgb emission_at(const SampledWavelengths* wavelengths, const Rgb& Le) {
+  return wavelengths ? wavelengths->illuminant(Le) : Le;
+}
 
 }  // namespace penumbra

@@ -60,7 +60,6 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <map>
-#include <optional>
 
 namespace {
 
@@ -222,13 +221,9 @@ class BdptIntegrator final : public SampleIntegrator {
   Rgb sample(const Scene& scene, const PixelSample& px, Sampler& sampler, SplatSink& splats) override {
     const int max_depth = config_.max_depth;
     if (!px.ray) return Rgb(0.f);
-    // The sample's wavelengths go with the context (a copy: the shared one stays RGB).
-    std::optional<Context> spectral_ctx;
-    if (px.wavelengths) {
-      spectral_ctx.emplace(*ctx_);
-      spectral_ctx->wavelengths = px.wavelengths;
-    }
-    const Context& ctx = spectral_ctx ? *spectral_ctx : *ctx_;
+    // The sample's wavelengths (null in RGB) go with a copy of the context (48 bytes).
+    Context ctx = *ctx_;
+    ctx.wavelengths = px.wavelengths;
     SubpathStorage<0> camera_path(max_depth + 2);
     SubpathStorage<1> own_light_path(max_depth + 1);
     PathSampler ps(sampler, px.pixel, px.index);

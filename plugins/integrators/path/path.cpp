@@ -33,8 +33,6 @@ class PathIntegrator final : public PixelIntegrator {
 
   Rgb Li(const Ray& camera_ray, const SampledWavelengths* wavelengths, Sampler& sampler,
          const Scene& scene) const override {
-    // Emitted radiance at the path's wavelengths in a spectral render, RGB otherwise.
-    auto emitted = [wavelengths](const Rgb& Le) { return wavelengths ? wavelengths->illuminant(Le) : Le; };
     Rgb L(0.f), beta(1.f);
     Ray ray = camera_ray;
     bool specular_bounce = false;
@@ -54,7 +52,7 @@ class PathIntegrator final : public PixelIntegrator {
         for (const Light* light : scene.infinite_lights()) {
           Rgb Le = light->Le(ray);
           if (is_black(Le)) continue;
-          Le = emitted(Le);
+          Le = emission_at(wavelengths, Le);
           if (depth == 0 || specular_bounce || !light_sampling_) {
             L += beta * Le;
           } else {
@@ -70,7 +68,7 @@ class PathIntegrator final : public PixelIntegrator {
       if (si->area_light) {
         Rgb Le = si->area_light->L(si->p, si->ng, si->uv, si->wo);
         if (!is_black(Le)) {
-          Le = emitted(Le);
+          Le = emission_at(wavelengths, Le);
           if (depth == 0 || specular_bounce || !light_sampling_) {
             L += beta * Le;
           } else {
@@ -143,7 +141,7 @@ class PathIntegrator final : public PixelIntegrator {
     if (scene.has_media())
       f *= scene.segment_transmittance(si.media.leaving(si.ng, ls->wi, arrived_in), kMediumUnknown,
                                        glm::length(ls->p_light - si.p), wavelengths);
-    Rgb Li = wavelengths ? wavelengths->illuminant(ls->L) : ls->L;
+    Rgb Li = emission_at(wavelengths, ls->L);
     float light_pdf = sl->pmf * ls->pdf;
     if (is_delta_light(sl->light->type())) return f * Li / light_pdf;
     float w = power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));

@@ -18,11 +18,6 @@ bool consistent_sides(const SurfaceInteraction& si, const Vec3& wo_local, const 
   return reflect_shading == reflect_geometric;
 }
 
-// Emitted radiance at the path's wavelengths in a spectral render, RGB otherwise.
-Rgb emitted(const SampledWavelengths* wavelengths, const Rgb& Le) {
-  return wavelengths ? wavelengths->illuminant(Le) : Le;
-}
-
 struct DirectSamples {
   float u_light;
   Vec2 u_light_point;
@@ -39,7 +34,7 @@ Rgb escaped_light(const Scene& scene, const Ray& ray, const LightSampleContext& 
     Rgb Le = light->Le(ray);
     if (is_black(Le)) continue;
     float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, none);
-    L += weight * emitted(wavelengths, Le) * power_heuristic(1, bsdf_pdf, 1, light_pdf);
+    L += weight * emission_at(wavelengths, Le) * power_heuristic(1, bsdf_pdf, 1, light_pdf);
   }
   return L;
 }
@@ -64,7 +59,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
                                            glm::length(ls->p_light - si.p), wavelengths);
         float light_pdf = sl->pmf * ls->pdf;
         float w = is_delta_light(sl->light->type()) ? 1.f : power_heuristic(1, light_pdf, 1, bsdf.pdf(wo, wi, sctx));
-        L += f * emitted(wavelengths, ls->L) * w / light_pdf;
+        L += f * emission_at(wavelengths, ls->L) * w / light_pdf;
       }
     }
   }
@@ -96,7 +91,7 @@ Rgb direct_light(const SurfaceInteraction& si, const Vec3& wo, const Bsdf& bsdf,
       Rgb Le = light->L(hit->p, hit->ng, hit->uv, hit->wo);
       if (!is_black(Le)) {
         float light_pdf = scene.light_pmf(light) * light->pdf_li(lctx, wi, *hit);
-        L += weight * emitted(wavelengths, Le) * power_heuristic(1, bs->pdf, 1, light_pdf);
+        L += weight * emission_at(wavelengths, Le) * power_heuristic(1, bs->pdf, 1, light_pdf);
       }
     }
   } else {
@@ -154,11 +149,11 @@ CameraPathResult trace_camera_path(const Scene& scene, const Ray& camera_ray, Sa
     bool count_emission = depth == 0 || specular_bounce;
     if (!si) {
       if (count_emission)
-        for (const Light* light : scene.infinite_lights()) out.Ld += beta * emitted(wavelengths, light->Le(ray));
+        for (const Light* light : scene.infinite_lights()) out.Ld += beta * emission_at(wavelengths, light->Le(ray));
       break;
     }
     if (si->area_light && count_emission)
-      out.Ld += beta * emitted(wavelengths, si->area_light->L(si->p, si->ng, si->uv, si->wo));
+      out.Ld += beta * emission_at(wavelengths, si->area_light->L(si->p, si->ng, si->uv, si->wo));
     distance += glm::length(si->p - ray.o);
     if (depth == max_depth) break;
 

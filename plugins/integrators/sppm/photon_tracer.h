@@ -38,8 +38,7 @@ void trace_photon(const Scene& scene, Pcg32& rng, int max_depth, const SampledWa
   // Points, spots and infinite lights have no surface at the origin: their L already is what
   // leaves along the ray (intensity, or radiance over the disk the ray starts on).
   float cos = le->n == Vec3(0.f) ? 1.f : std::abs(glm::dot(le->n, glm::normalize(le->ray.d)));
-  Rgb L = wavelengths ? wavelengths->illuminant(le->L) : le->L;
-  Rgb beta = L * cos / (sl->pmf * le->pdf_pos * le->pdf_dir);
+  Rgb beta = emission_at(wavelengths, le->L) * cos / (sl->pmf * le->pdf_pos * le->pdf_dir);
   if (!is_finite(beta) || is_black(beta)) return;
 
   Ray ray = le->ray;
