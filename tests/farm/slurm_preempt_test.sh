@@ -115,7 +115,10 @@ log0="$D/work/out.parts/slurm-${array}_0.log"
 grep -q "interrupted (SIGTERM)" "$log0" || fail "penumbra in task 0 did not get the SIGTERM"
 grep -q "part 0 was interrupted" "$log0" || fail "task 0 did not report its interruption"
 [ -f "$ckpt" ] || fail "task 0's checkpoint is gone after the interruption"
-scontrol update jobid="${array}_0" starttime=now
+# Not "starttime=now": slurmd revokes the killed run's credential with a time stamp in whole seconds
+# and refuses a launch whose credential is from the same second ("Job credential revoked"; the task
+# then fails and the merge job waits forever on its dependency). Two seconds later is always safe.
+scontrol update jobid="${array}_0" starttime=now+2
 
 # Everything finishes: both tasks, then the merge job.
 for _ in $(seq 1200); do
