@@ -62,10 +62,12 @@ PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const 
   if (type == "gaussian") {
     sigma_ = params.get_float("sigma");
     if (!(sigma_ > 0.f)) throw Error(params.loc_of("sigma"), "sigma must be > 0");
+    for (int axis = 0; axis < 2; ++axis)
+      gaussian_at_radius_[axis] = std::exp(-radius_[axis] * radius_[axis] / (2.f * sigma_ * sigma_));
     for (int axis = 0; axis < 2; ++axis) {
       const int n = 4096;
       std::vector<float> f(n);
-      for (int i = 0; i < n; ++i) f[i] = eval_gaussian(radius_[axis] * (2.f * (i + 0.5f) / n - 1.f), radius_[axis]);
+      for (int i = 0; i < n; ++i) f[i] = eval_gaussian(radius_[axis] * (2.f * (i + 0.5f) / n - 1.f), axis);
       Distribution1D fine(f);
       std::vector<float>& inv = inverse_cdf_[axis];
       inv.resize(kInverseSize + 1);
@@ -85,7 +87,7 @@ PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const 
     } else {  // the Gaussian's integral by the midpoint rule (4096 intervals: relative error below 1e-7)
       const int n = 4096;
       double sum = 0.0;
-      for (int i = 0; i < n; ++i) sum += eval_gaussian(r * (2.f * (i + 0.5f) / n - 1.f), r);
+      for (int i = 0; i < n; ++i) sum += eval_gaussian(r * (2.f * (i + 0.5f) / n - 1.f), axis);
       integral_[axis] = static_cast<float>(sum * 2.0 * r / n);
     }
   }
@@ -96,14 +98,14 @@ float PixelFilter::evaluate_axis(float x, int axis) const {
   if (!(std::abs(x) < r)) return 0.f;
   if (shape_ == Shape::Box) return 1.f;
   if (shape_ == Shape::Triangle) return r - std::abs(x);
-  return eval_gaussian(x, r);
+  return eval_gaussian(x, axis);
 }
 
 float PixelFilter::normalized(float x, int axis) const { return evaluate_axis(x, axis) / integral_[axis]; }
 
-float PixelFilter::eval_gaussian(float x, float r) const {
-  auto g = [&](float t) { return std::exp(-t * t / (2.f * sigma_ * sigma_)); };
-  return std::max(0.f, g(x) - g(r));
+// The Gaussian shifted down to reach 0 at the radius (its value there is computed once).
+float PixelFilter::eval_gaussian(float x, int axis) const {
+  return std::max(0.f, std::exp(-x * x / (2.f * sigma_ * sigma_)) - gaussian_at_radius_[axis]);
 }
 
 // Samples one axis of the separable filter; `weight` gets f(x)/pdf(x), up to a constant factor that
@@ -124,7 +126,7 @@ float PixelFilter::sample_axis(float u, int axis, float* weight) const {
   float width = inv[k + 1] - inv[k];
   float x = inv[k] + (t - k) * width;
   // pdf(x) = 1 / (kInverseSize * width) on this interval.
-  *weight = eval_gaussian(x, r) * kInverseSize * width;
+  *weight = eval_gaussian(x, axis) * kInverseSize * width;
   return x;
 }
 

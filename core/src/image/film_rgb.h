@@ -35,11 +35,12 @@ class PixelFilter {
   float sample_axis(float u, int axis, float* weight) const;
   float evaluate_axis(float x, int axis) const;
   Vec2 integral_{1.f};  // per axis, the integral of evaluate_axis over [-radius, radius]
-  float eval_gaussian(float x, float r) const;
+  float eval_gaussian(float x, int axis) const;
   std::string type_;
   enum class Shape { Box, Triangle, Gaussian } shape_;  // type_ as decided once (splats ask per pixel)
   Vec2 radius_;
   float sigma_ = 0.5f;
+  Vec2 gaussian_at_radius_{0.f};  // Gaussian: exp(-r^2 / (2 sigma^2)) per axis, what eval_gaussian subtracts
   // Gaussian only: per axis, the inverse CDF at kInverseSize + 1 evenly spaced probabilities, so a
   // sample costs one lookup; the density is constant between entries, so f / pdf stays exact.
   static constexpr int kInverseSize = 1024;
