@@ -62,8 +62,11 @@ def main():
             if not stats:
                 continue
             seconds = statistics.median(s["seconds"] for s in stats)
-            passes = statistics.median(s["spp"] for s in stats)
-            pps = statistics.median(s["spp"] / s["seconds"] for s in stats if s["seconds"] > 0)
+            # What the image holds: a pass cut by the time budget counts with the samples it took
+            # (samples_per_pixel; older stats files have only the whole passes, spp).
+            taken = [s.get("samples_per_pixel", s["spp"]) for s in stats]
+            passes = round(statistics.median(taken), 1)
+            pps = statistics.median(n / s["seconds"] for n, s in zip(taken, stats) if s["seconds"] > 0)
             mrays = statistics.median(s["mrays_per_second"] for s in stats)
             nonfinite = sum(s["nonfinite_samples"] for s in stats) + sum(e.get("nonfinite", 0) for e in errs if e)
             rel = [e["relmse"] for e in errs if e and e.get("relmse") is not None]

@@ -456,6 +456,10 @@ RenderResult render(const RenderSettings& settings) {
   s.seconds = seconds;
   s.load_seconds = load_seconds;
   s.spp = session.completed_spp();
+  const auto* sample_integrator = dynamic_cast<const SampleIntegrator*>(built.integrator.get());
+  s.samples_per_pixel = sample_integrator && sample_integrator->film_holds_estimate()
+                            ? std::max(session.splat_spp(), static_cast<double>(s.spp))
+                            : s.spp;
   s.pixels = static_cast<uint64_t>(result.image.width) * result.image.height;
   s.rays = total_rays() - rays_before;
   s.nonfinite_samples = session.nonfinite();
@@ -502,7 +506,8 @@ std::string stats_json(const RenderStats& s) {
   j["pixels"] = s.pixels;
   j["rays"] = s.rays;
   j["mrays_per_second"] = s.mrays_per_second();
-  j["samples_per_second"] = s.seconds > 0 ? s.pixels * static_cast<double>(s.spp) / s.seconds : 0.0;
+  j["samples_per_pixel"] = s.samples_per_pixel;
+  j["samples_per_second"] = s.seconds > 0 ? s.pixels * s.samples_per_pixel / s.seconds : 0.0;
   j["plugins_loaded"] = s.plugins_loaded;
   j["structures_built"] = s.structures_built;
   j["nonfinite_samples"] = s.nonfinite_samples;

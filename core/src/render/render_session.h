@@ -84,6 +84,9 @@ struct RenderStats {
   double seconds = 0.0;        // rendering only
   double load_seconds = 0.0;   // parsing, plugin loading, BVH build
   int spp = 0;
+  // Pixel samples in the image over the pixel count: spp plus what a pass cut by the time budget
+  // added (equal to spp where the integrator drops a cut pass, as sppm does its iteration).
+  double samples_per_pixel = 0.0;
   uint64_t pixels = 0;
   uint64_t rays = 0;
   uint64_t nonfinite_samples = 0;
