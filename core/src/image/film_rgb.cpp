@@ -62,9 +62,8 @@ PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const 
   if (type == "gaussian") {
     sigma_ = params.get_float("sigma");
     if (!(sigma_ > 0.f)) throw Error(params.loc_of("sigma"), "sigma must be > 0");
-    for (int axis = 0; axis < 2; ++axis)
-      gaussian_at_radius_[axis] = std::exp(-radius_[axis] * radius_[axis] / (2.f * sigma_ * sigma_));
     for (int axis = 0; axis < 2; ++axis) {
+      gaussian_at_radius_[axis] = std::exp(-radius_[axis] * radius_[axis] / (2.f * sigma_ * sigma_));
       const int n = 4096;
       std::vector<float> f(n);
       for (int i = 0; i < n; ++i) f[i] = eval_gaussian(radius_[axis] * (2.f * (i + 0.5f) / n - 1.f), axis);
