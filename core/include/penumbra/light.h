@@ -35,10 +35,13 @@ struct LightSampleContext {
   bool allow_incomplete_pdf = false;
 };
 
+/// The geometric normal of a surface hit, turned to the side of wo.
+inline Vec3 ng_towards_wo(const SurfaceInteraction& si) { return glm::dot(si.ng, si.wo) < 0.f ? -si.ng : si.ng; }
+
 /// The context for light sampling at a surface hit that is combined with BSDF sampling by MIS: the
 /// geometric normal on the side of wo, allow_incomplete_pdf set.
 inline LightSampleContext mis_light_context(const SurfaceInteraction& si) {
-  return LightSampleContext{si.p, glm::dot(si.ng, si.wo) < 0.f ? -si.ng : si.ng, true};
+  return LightSampleContext{si.p, ng_towards_wo(si), true};
 }
 
 struct LightLiSample {
