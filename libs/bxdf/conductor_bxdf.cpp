@@ -26,19 +26,22 @@ Rgb ConductorBxdf::f(const Vec3& wo, const Vec3& wi, TransportMode) const {
 
 std::optional<BsdfSample> ConductorBxdf::sample_f(const Vec3& wo, float, Vec2 u, TransportMode mode,
                                                   Lobes allowed) const {
-  if (wo.z == 0.f || !allows(allowed, Lobes::Reflection)) return std::nullopt;
+  std::optional<BsdfSample> bs;  // the one object every path returns (emplace_sample)
+  if (wo.z == 0.f || !allows(allowed, Lobes::Reflection)) return bs;
   if (distrib_.effectively_smooth()) {
     // Delta reflection: the weight f |cos| / pdf must be F, so f carries F / |cos|.
     Vec3 wi(-wo.x, -wo.y, wo.z);
     float cos_i = abs_cos_theta(wi);
-    return BsdfSample{fresnel_complex(cos_i, eta_, k_) / cos_i, wi, 1.f, BsdfReflection | BsdfSpecular};
+    emplace_sample(bs, fresnel_complex(cos_i, eta_, k_) / cos_i, wi, 1.f, BsdfReflection | BsdfSpecular);
+    return bs;
   }
   Vec3 wm = distrib_.sample_wm(wo, u);
   Vec3 wi = reflect(wo, wm);
-  if (!same_hemisphere(wo, wi)) return std::nullopt;  // reflected into the microsurface
+  if (!same_hemisphere(wo, wi)) return bs;  // reflected into the microsurface
   float pdf = distrib_.pdf(wo, wm) / (4.f * std::abs(glm::dot(wo, wm)));
-  if (!(pdf > 0.f) || wi.z == 0.f) return std::nullopt;
-  return BsdfSample{f(wo, wi, mode), wi, pdf, BsdfReflection | BsdfGlossy};
+  if (!(pdf > 0.f) || wi.z == 0.f) return bs;
+  emplace_sample(bs, f(wo, wi, mode), wi, pdf, BsdfReflection | BsdfGlossy);
+  return bs;
 }
 
 float ConductorBxdf::pdf(const Vec3& wo, const Vec3& wi, TransportMode, Lobes allowed) const {

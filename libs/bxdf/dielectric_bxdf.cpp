@@ -38,38 +38,48 @@ Rgb DielectricBxdf::f(const Vec3& wo, const Vec3& wi, TransportMode mode) const 
 std::optional<BsdfSample> DielectricBxdf::sample_f(const Vec3& wo, float uc, Vec2 u, TransportMode mode,
                                                    Lobes allowed, float* choice) const {
   if (choice) *choice = 1.f;
-  if (wo.z == 0.f) return std::nullopt;
-  if (eta_ == 1.f) {
-    if (!allows(allowed, Lobes::Transmission)) return std::nullopt;
-    return BsdfSample{Rgb(1.f / std::abs(wo.z)), -wo, 1.f, BsdfTransmission | BsdfSpecular};
-  }
-  if (smooth()) return sample_smooth(wo, uc, mode, allowed, choice);
+  // Both return a prvalue of this type, so neither result is copied.
+  if (wo.z != 0.f && eta_ != 1.f && smooth()) return sample_smooth(wo, uc, mode, allowed, choice);
+  return sample_rough(wo, uc, u, mode, allowed, choice);
+}
 
+// The index-matched pass-through, and rough interfaces.
+std::optional<BsdfSample> DielectricBxdf::sample_rough(const Vec3& wo, float uc, Vec2 u, TransportMode mode,
+                                                       Lobes allowed, float* choice) const {
+  std::optional<BsdfSample> bs;  // the one object every path returns (emplace_sample)
+  if (wo.z == 0.f) return bs;
+  if (eta_ == 1.f) {
+    if (!allows(allowed, Lobes::Transmission)) return bs;
+    emplace_sample(bs, Rgb(1.f / std::abs(wo.z)), -wo, 1.f, BsdfTransmission | BsdfSpecular);
+    return bs;
+  }
   Vec3 wm = distrib_.sample_wm(wo, u);
   float R = fresnel_dielectric(glm::dot(wo, wm), eta_), T = 1.f - R;
   float pdf_wm = distrib_.pdf(wo, wm);
-  if (!(pdf_wm > 0.f)) return std::nullopt;
+  if (!(pdf_wm > 0.f)) return bs;
   Choice c = restrict_choice(R, T, allowed);
-  if (c.pr == 0.f && c.pt == 0.f) return std::nullopt;
+  if (c.pr == 0.f && c.pt == 0.f) return bs;
   if (uc < c.pr / (c.pr + c.pt)) {
     Vec3 wi = reflect(wo, wm);
-    if (!same_hemisphere(wo, wi)) return std::nullopt;
+    if (!same_hemisphere(wo, wi)) return bs;
     float pdf = pdf_wm / (4.f * std::abs(glm::dot(wo, wm))) * c.pr / (c.pr + c.pt);
     Rgb fr(distrib_.D(wm) * distrib_.G(wo, wi) * R / std::abs(4.f * wo.z * wi.z));
     if (choice) *choice = R / (R + T);
-    return BsdfSample{fr, wi, pdf, BsdfReflection | BsdfGlossy};
+    emplace_sample(bs, fr, wi, pdf, BsdfReflection | BsdfGlossy);
+    return bs;
   }
   float etap;
   Vec3 wi;
-  if (!refract(wo, wm, eta_, &etap, &wi) || same_hemisphere(wo, wi) || wi.z == 0.f) return std::nullopt;
+  if (!refract(wo, wm, eta_, &etap, &wi) || same_hemisphere(wo, wi) || wi.z == 0.f) return bs;
   float dot_i = glm::dot(wi, wm), dot_o = glm::dot(wo, wm);
   float denom = sqr(dot_i + dot_o / etap);
   float pdf = pdf_wm * std::abs(dot_i) / denom * c.pt / (c.pr + c.pt);
   float ft = distrib_.D(wm) * distrib_.G(wo, wi) * T * std::abs(dot_i * dot_o / (denom * wi.z * wo.z));
   if (mode == TransportMode::Radiance) ft /= sqr(etap);
-  if (!(pdf > 0.f) || !std::isfinite(pdf)) return std::nullopt;
+  if (!(pdf > 0.f) || !std::isfinite(pdf)) return bs;
   if (choice) *choice = T / (R + T);
-  return BsdfSample{Rgb(ft), wi, pdf, BsdfTransmission | BsdfGlossy, etap};
+  emplace_sample(bs, Rgb(ft), wi, pdf, BsdfTransmission | BsdfGlossy, etap);
+  return bs;
 }
 
 float DielectricBxdf::pdf(const Vec3& wo, const Vec3& wi, TransportMode, Lobes allowed) const {
@@ -112,26 +122,29 @@ std::optional<BsdfSample> DielectricBxdf::sample_smooth(const Vec3& wo, float uc
   // Choosing the lobe with probability R makes every sample's weight exactly 1 (1/eta'^2 for
   // transmitted radiance): f |cos| / pdf = (R / |cos|) |cos| / R. A restricted choice keeps f and
   // takes the conditional probability.
+  std::optional<BsdfSample> bs;  // the one object every path returns (emplace_sample)
   float R = fresnel_dielectric(wo.z, eta_), T = 1.f - R;
   float pr = R, pt = T;
   if (allowed != Lobes::All) {
     Choice c = restrict_choice(R, T, allowed);
-    if (c.pr == 0.f && c.pt == 0.f) return std::nullopt;
+    if (c.pr == 0.f && c.pt == 0.f) return bs;
     pr = c.pr / (c.pr + c.pt);
     pt = c.pt / (c.pr + c.pt);
   }
   if (uc < pr) {
     Vec3 wi(-wo.x, -wo.y, wo.z);
     if (choice) *choice = R;
-    return BsdfSample{Rgb(R / std::abs(wi.z)), wi, pr, BsdfReflection | BsdfSpecular};
+    emplace_sample(bs, Rgb(R / std::abs(wi.z)), wi, pr, BsdfReflection | BsdfSpecular);
+    return bs;
   }
   float etap;
   Vec3 wi;
-  if (!refract(wo, Vec3(0.f, 0.f, 1.f), eta_, &etap, &wi) || wi.z == 0.f) return std::nullopt;
+  if (!refract(wo, Vec3(0.f, 0.f, 1.f), eta_, &etap, &wi) || wi.z == 0.f) return bs;
   float ft = T / std::abs(wi.z);
   if (mode == TransportMode::Radiance) ft /= sqr(etap);
   if (choice) *choice = T;
-  return BsdfSample{Rgb(ft), wi, pt, BsdfTransmission | BsdfSpecular, etap};
+  emplace_sample(bs, Rgb(ft), wi, pt, BsdfTransmission | BsdfSpecular, etap);
+  return bs;
 }
 
 std::optional<DielectricBxdf::Pair> DielectricBxdf::pair(const Vec3& wo, const Vec3& wi) const {

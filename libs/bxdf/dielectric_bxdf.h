@@ -40,6 +40,8 @@ class DielectricBxdf {
  private:
   std::optional<BsdfSample> sample_smooth(const Vec3& wo, float uc, TransportMode mode, Lobes allowed,
                                           float* choice) const;
+  std::optional<BsdfSample> sample_rough(const Vec3& wo, float uc, Vec2 u, TransportMode mode, Lobes allowed,
+                                         float* choice) const;
   // The microfacet normal that scatters wo into wi, with what kind of event it is.
   struct Pair {
     Vec3 wm;

@@ -5,12 +5,14 @@
 namespace penumbra::bxdf {
 
 std::optional<BsdfSample> DiffuseBxdf::sample_f(const Vec3& wo, float, Vec2 u, TransportMode, Lobes allowed) const {
-  if (wo.z == 0.f || is_black(r_) || !allows(allowed, Lobes::Reflection)) return std::nullopt;
+  std::optional<BsdfSample> bs;  // the one object every path returns (emplace_sample)
+  if (wo.z == 0.f || is_black(r_) || !allows(allowed, Lobes::Reflection)) return bs;
   Vec3 wi = sample_cosine_hemisphere(u);
   if (wo.z < 0.f) wi.z = -wi.z;
   float pdf = cosine_hemisphere_pdf(std::abs(wi.z));
-  if (pdf == 0.f) return std::nullopt;
-  return BsdfSample{r_ * InvPi, wi, pdf, BsdfReflection | BsdfDiffuse};
+  if (pdf == 0.f) return bs;
+  emplace_sample(bs, r_ * InvPi, wi, pdf, BsdfReflection | BsdfDiffuse);
+  return bs;
 }
 
 float DiffuseBxdf::pdf(const Vec3& wo, const Vec3& wi, TransportMode, Lobes allowed) const {

@@ -86,9 +86,11 @@ std::optional<Ray> PerspectiveCamera::generate_ray(const CameraSample& s) const 
     origin = Vec3(lens, 0.f);
     dir = focus - origin;
   }
-  Vec3 o = Vec3(to_world_ * Vec4(origin, 1.f));
-  Vec3 d = glm::normalize(Vec3(to_world_ * Vec4(dir, 0.f)));
-  return Ray{o, d, Infinity};
+  std::optional<Ray> ray(std::in_place);  // filled where the caller receives it (no copy out)
+  ray->o = Vec3(to_world_ * Vec4(origin, 1.f));
+  ray->d = glm::normalize(Vec3(to_world_ * Vec4(dir, 0.f)));
+  ray->tmax = Infinity;
+  return ray;
 }
 
 }  // namespace penumbra
@@ -133,19 +135,25 @@ void PerspectiveCamera::pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) c
 std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Vec2 u) const {
   Vec3 lens(0.f);
   if (lens_radius_ > 0.f) lens = Vec3(lens_radius_ * sample_uniform_disk_concentric(u), 0.f);
-  CameraWiSample s;
+  // The one object every path returns, built where the caller receives it (no copy out).
+  std::optional<CameraWiSample> out;
+  CameraWiSample& s = out.emplace();
   s.p_lens = Vec3(to_world_ * Vec4(lens, 1.f));
   Vec3 d = s.p_lens - p_ref;
   float dist2 = glm::dot(d, d);
-  if (!(dist2 > 0.f)) return std::nullopt;
-  s.wi = d / std::sqrt(dist2);
-  float cos_lens = std::abs(glm::dot(axis_, s.wi));
-  if (cos_lens == 0.f) return std::nullopt;
-  s.We = We(Ray{s.p_lens, -s.wi, Infinity}, &s.p_raster);
-  if (is_black(s.We)) return std::nullopt;
+  float cos_lens = 0.f;
+  if (dist2 > 0.f) {
+    s.wi = d / std::sqrt(dist2);
+    cos_lens = std::abs(glm::dot(axis_, s.wi));
+  }
+  if (cos_lens != 0.f) s.We = We(Ray{s.p_lens, -s.wi, Infinity}, &s.p_raster);
+  if (is_black(s.We)) {  // also where dist2 or cos_lens is 0 (We stays 0)
+    out.reset();
+    return out;
+  }
   // Uniform by lens area, converted to solid angle at the reference point.
   s.pdf = dist2 / (cos_lens * lens_area_);
-  return s;
+  return out;
 }
 
 }  // namespace penumbra

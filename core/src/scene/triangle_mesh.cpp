@@ -96,10 +96,20 @@ float TriangleMesh::area(size_t i) const {
 }
 
 ShapeSample Triangle::sample_area(Vec2 u) const {
+  ShapeSample s;
+  area_sample_into(u, s);
+  return s;
+}
+
+// Samples are written field by field into the object the caller returns: built whole and copied
+// out of an std::optional, they stalled store forwarding (docs/benchmarks.md, "Results built in place").
+void Triangle::area_sample_into(Vec2 u, ShapeSample& s) const {
   Vec2 b12 = sample_uniform_triangle(u);
   Vec3 b(1.f - b12.x - b12.y, b12.x, b12.y);
-  return ShapeSample{mesh_->position(index_, b), mesh_->geometric_normal(index_, b),
-                     mesh_->uv_at(index_, b), 1.f / area()};
+  s.p = mesh_->position(index_, b);
+  s.n = mesh_->geometric_normal(index_, b);
+  s.uv = mesh_->uv_at(index_, b);
+  s.pdf = 1.f / area();
 }
 
 namespace {
@@ -191,10 +201,12 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
 }
 
 std::optional<ShapeSample> Triangle::sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const {
-  ShapeSample s = sample_area(u);
+  std::optional<ShapeSample> out;
+  ShapeSample& s = out.emplace();
+  area_sample_into(u, s);
   s.pdf = area_to_solid_angle_pdf(s.pdf, ctx.p, s.p, s.n);
-  if (!(s.pdf > 0.f) || std::isinf(s.pdf)) return std::nullopt;
-  return s;
+  if (!(s.pdf > 0.f) || std::isinf(s.pdf)) out.reset();
+  return out;
 }
 
 float Triangle::pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,

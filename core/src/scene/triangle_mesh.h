@@ -56,6 +56,7 @@ class Triangle final : public Shape {
  private:
   bool spherical_worthwhile(const Vec3& p) const;
   std::optional<ShapeSample> sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const;
+  void area_sample_into(Vec2 u, ShapeSample& s) const;
   const TriangleMesh* mesh_;
   uint32_t index_;
   Vec3 centroid_;

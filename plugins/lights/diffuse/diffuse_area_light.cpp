@@ -27,15 +27,22 @@ class DiffuseAreaLight final : public Light {
   }
 
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
+    std::optional<LightLiSample> ls;  // the one object every path returns (see Light::sample_li)
     std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, u);
-    if (!ss || !(ss->pdf > 0.f) || !shape_->present(*ss)) return std::nullopt;
+    if (!ss || !(ss->pdf > 0.f) || !shape_->present(*ss)) return ls;
     Vec3 d = ss->p - ctx.p;
     float len = glm::length(d);
-    if (len == 0.f) return std::nullopt;
+    if (len == 0.f) return ls;
     Vec3 wi = d / len;
     Rgb Le = L(ss->p, ss->n, ss->uv, -wi);
-    if (is_black(Le)) return std::nullopt;
-    return LightLiSample{Le, wi, ss->pdf, ss->p, ss->n};
+    if (is_black(Le)) return ls;
+    ls.emplace();
+    ls->L = Le;
+    ls->wi = wi;
+    ls->pdf = ss->pdf;
+    ls->p_light = ss->p;
+    ls->n_light = ss->n;
+    return ls;
   }
 
   float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const SurfaceInteraction& hit) const override {

@@ -64,6 +64,15 @@ class InfiniteLight final : public Light {
   Rgb Le(const Ray& ray) const override { return radiance(to_light_ * glm::normalize(ray.d)); }
 
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
+    std::optional<LightLiSample> ls;  // the one object every path returns, filled by set()
+    // A target outside the scene's bounding sphere, so a shadow ray tests all geometry.
+    auto set = [&](const Rgb& L, const Vec3& wi, float pdf) {
+      ls.emplace();
+      ls->L = L;
+      ls->wi = wi;
+      ls->pdf = pdf;
+      ls->p_light = ctx.p + wi * (2.f * radius_);
+    };
     Vec3 w_light;
     float pdf;
     if (!has_image() && ctx.n != Vec3(0.f)) {
@@ -78,8 +87,8 @@ class InfiniteLight final : public Light {
       }
       Vec3 wi = Frame(n).to_world(sample_cosine_hemisphere(u));
       pdf = constant_pdf(ctx, wi);  // as pdf_li() computes it
-      if (!(pdf > 0.f) || is_black(constant_)) return std::nullopt;
-      return LightLiSample{constant_, wi, pdf, ctx.p + wi * (2.f * radius_), Vec3(0.f)};
+      if (pdf > 0.f && !is_black(constant_)) set(constant_, wi, pdf);
+      return ls;
     }
     if (!has_image()) {
       w_light = sample_uniform_sphere(u);
@@ -87,15 +96,14 @@ class InfiniteLight final : public Light {
     } else {
       float pdf_uv;
       Vec2 uv = distribution_.sample_continuous(u, &pdf_uv);
-      if (pdf_uv == 0.f) return std::nullopt;
+      if (pdf_uv == 0.f) return ls;
       w_light = envmap::uv_to_direction(mapping_, uv);
       pdf = pdf_uv_to_solid_angle(pdf_uv, w_light);
     }
     Rgb L = radiance(w_light);
-    if (is_black(L) || !(pdf > 0.f)) return std::nullopt;
-    Vec3 wi = glm::normalize(to_world_ * w_light);
-    // A target outside the scene's bounding sphere, so a shadow ray tests all geometry.
-    return LightLiSample{L, wi, pdf, ctx.p + wi * (2.f * radius_), Vec3(0.f)};
+    if (is_black(L) || !(pdf > 0.f)) return ls;
+    set(L, glm::normalize(to_world_ * w_light), pdf);
+    return ls;
   }
 
   // A constant sky samples about the receiving normal; a map by its distribution alone.
@@ -110,12 +118,17 @@ class InfiniteLight final : public Light {
   // A direction as sample_li() draws it, and an origin on a disk of the scene's radius perpendicular
   // to it, outside the scene's bounding sphere.
   std::optional<LightLeSample> sample_le(Vec2 u_pos, Vec2 u_dir) const override {
+    std::optional<LightLeSample> le;  // the one object every path returns
     auto s = sample_li(LightSampleContext{center_}, u_dir);
-    if (!s) return std::nullopt;
+    if (!s) return le;
     Vec2 d = sample_uniform_disk_concentric(u_pos);
     Frame f(s->wi);
-    Vec3 origin = center_ + radius_ * (s->wi + d.x * f.s + d.y * f.t);
-    return LightLeSample{Ray{origin, -s->wi}, Vec3(0.f), s->L, 1.f / (Pi * radius_ * radius_), s->pdf};
+    le.emplace();
+    le->ray = Ray{center_ + radius_ * (s->wi + d.x * f.s + d.y * f.t), -s->wi};
+    le->L = s->L;
+    le->pdf_pos = 1.f / (Pi * radius_ * radius_);
+    le->pdf_dir = s->pdf;
+    return le;
   }
 
   void pdf_le(const Ray& ray, const Vec3&, float* pdf_pos, float* pdf_dir) const override {
