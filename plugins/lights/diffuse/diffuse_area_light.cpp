@@ -27,7 +27,7 @@ class DiffuseAreaLight final : public Light {
   }
 
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
-    std::optional<LightLiSample> ls;  // the one object every path returns (see Light::sample_li)
+    std::optional<LightLiSample> ls;  // returned by name on every path (why: emplace_sample(), penumbra/bsdf.h)
     std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, u);
     if (!ss || !(ss->pdf > 0.f) || !shape_->present(*ss)) return ls;
     Vec3 d = ss->p - ctx.p;

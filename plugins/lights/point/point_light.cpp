@@ -19,7 +19,7 @@ class PointLight final : public Light {
   LightType type() const override { return LightType::DeltaPosition; }
   Rgb power() const override { return 4.f * Pi * I_; }
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2) const override {
-    std::optional<LightLiSample> ls;  // the one object every path returns (see Light::sample_li)
+    std::optional<LightLiSample> ls;  // returned by name on every path (why: emplace_sample(), penumbra/bsdf.h)
     Vec3 d = p_ - ctx.p;
     float dist2 = glm::dot(d, d);
     if (dist2 == 0.f) return ls;  // a point light on the receiving point delivers nothing finite
