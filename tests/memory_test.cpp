@@ -74,7 +74,8 @@ TEST(Memory, EveryLargeStructureIsAnnouncedBeforeRendering) {
   } cases[] = {
       {{"--integrator", "sppm"}, "error: sppm's per-pixel statistics would need an estimated "},
       {{"--integrator", "lighttracing"},
-       "error: the film's splat buffers would need an estimated 30.0 MiB (512x512 pixels, 48 bytes each for each of 2 threads)"},
+       "error: the film's splat buffers would need an estimated 34.0 MiB (512x512 pixels, 48 bytes each in 2 MiB chunks, "
+       "for each of 2 threads)"},
       {{"--integrator", "bdpt", "--param", "hrr=true"}, "error: bdpt's light-vertex cache would need an estimated "},
   };
   for (const Case& c : cases) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <new>
+#include <sys/mman.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -21,9 +23,33 @@ SplatBuffers::SplatBuffers(Point2i resolution)
 
 uint64_t SplatBuffers::worst_case_bytes(Point2i resolution, int threads) {
   uint64_t blocks = static_cast<uint64_t>((resolution.x + kBlock - 1) / kBlock) * ((resolution.y + kBlock - 1) / kBlock);
+  uint64_t chunks = (blocks + kBlocksPerChunk - 1) / kBlocksPerChunk;
   uint64_t pixels = static_cast<uint64_t>(resolution.x) * resolution.y;
-  return static_cast<uint64_t>(std::max(threads, 1)) * blocks * (sizeof(Block) + sizeof(std::unique_ptr<Block>)) +
+  return static_cast<uint64_t>(std::max(threads, 1)) * (chunks * kChunkBytes + blocks * sizeof(Block*)) +
          pixels * 3 * sizeof(double);
+}
+
+void SplatBuffers::Unmap::operator()(void* p) const { munmap(p, kChunkBytes); }
+
+SplatBuffers::Block* SplatBuffers::ThreadBuffer::new_block() {
+  if (chunk_used == kBlocksPerChunk) {
+    // Fresh pages, 2 MiB-aligned: twice the size is mapped and the ends beyond the aligned chunk
+    // are returned, so the first touch can fault in a huge page (where the kernel allows them).
+    size_t span = 2 * kChunkBytes;
+    void* raw = mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (raw == MAP_FAILED) throw std::bad_alloc();
+    uintptr_t start = reinterpret_cast<uintptr_t>(raw);
+    uintptr_t aligned = (start + kChunkBytes - 1) & ~(uintptr_t{kChunkBytes} - 1);
+    if (aligned > start) munmap(raw, aligned - start);
+    if (aligned + kChunkBytes < start + span)
+      munmap(reinterpret_cast<void*>(aligned + kChunkBytes), start + span - aligned - kChunkBytes);
+    void* chunk = reinterpret_cast<void*>(aligned);
+    madvise(chunk, kChunkBytes, MADV_HUGEPAGE);  // a hint: without huge pages all works as before
+    chunks.emplace_back(chunk);
+    chunk_used = 0;
+  }
+  void* at = static_cast<char*>(chunks.back().get()) + chunk_used++ * sizeof(Block);
+  return new (at) Block;  // mapped pages are zero: the sums start at 0
 }
 
 // The calling thread's buffer: TBB's lookup by thread id once, then a thread-local cache (a splat
@@ -60,9 +86,9 @@ bool SplatBuffers::add(int x, int y, const Rgb& v) {
   }
   ThreadBuffer& tb = local();
   if (tb.blocks.empty()) tb.blocks.resize(static_cast<size_t>(blocks_x_) * blocks_y_);
-  std::unique_ptr<Block>& b = tb.blocks[static_cast<size_t>(y / kBlock) * blocks_x_ + x / kBlock];
+  Block*& b = tb.blocks[static_cast<size_t>(y / kBlock) * blocks_x_ + x / kBlock];
   if (!b) {
-    b = std::make_unique<Block>();
+    b = tb.new_block();
     any_.store(true, std::memory_order_relaxed);
   }
   Fixed* p = &b->v[3 * ((y % kBlock) * kBlock + x % kBlock)];

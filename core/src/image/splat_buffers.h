@@ -48,10 +48,20 @@ class SplatBuffers {
     Fixed* p;
     Fixed q[3];
   };
+  // Blocks are carved from 2 MiB chunks mapped for the purpose and marked for huge pages: splats
+  // land on random blocks, and with 4 KiB pages (three per block) each one missed the TLB.
+  static constexpr size_t kChunkBytes = size_t{2} << 20;
+  static constexpr size_t kBlocksPerChunk = kChunkBytes / sizeof(Block);
+  struct Unmap {
+    void operator()(void* p) const;
+  };
   struct ThreadBuffer {
-    std::vector<std::unique_ptr<Block>> blocks;
+    std::vector<Block*> blocks;  // per 16x16 block of the film, null until the first splat there
+    std::vector<std::unique_ptr<void, Unmap>> chunks;
+    size_t chunk_used = kBlocksPerChunk;  // blocks taken from the last chunk
     Pending pending[kPending];
     int pending_count = 0, pending_next = 0;
+    Block* new_block();
   };
   static void apply(const Pending& e) {
     for (int c = 0; c < 3; ++c) e.p[c] += e.q[c];

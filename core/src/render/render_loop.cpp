@@ -103,7 +103,7 @@ void SampleIntegrator::render(RenderContext& ctx) {
   if (to_film && !dynamic_cast<const PixelIntegrator*>(this)) {
     int threads = opt.threads > 0 ? opt.threads : tbb::this_task_arena::max_concurrency();
     require_memory(SplatBuffers::worst_case_bytes(res, threads), "the film's splat buffers",
-                   fmt::format("{}x{} pixels, 48 bytes each for each of {} threads", res.x, res.y, threads));
+                   fmt::format("{}x{} pixels, 48 bytes each in 2 MiB chunks, for each of {} threads", res.x, res.y, threads));
   }
 
   tbb::enumerable_thread_specific<ThreadState> threads(
