@@ -49,7 +49,7 @@ SplatBuffers::Block* SplatBuffers::ThreadBuffer::new_block() {
     chunk_used = 0;
   }
   void* at = static_cast<char*>(chunks.back().get()) + chunk_used++ * sizeof(Block);
-  return new (at) Block;  // mapped pages are zero: the sums start at 0
+  return new (at) Block{};
 }
 
 // The calling thread's buffer: TBB's lookup by thread id once, then a thread-local cache (a splat
