@@ -49,7 +49,8 @@ class SplatBuffers {
     Fixed q[3];
   };
   // Blocks are carved from 2 MiB chunks mapped for the purpose and marked for huge pages: splats
-  // land on random blocks, and with 4 KiB pages (three per block) each one missed the TLB.
+  // land on random blocks, and with 4 KiB pages (three per block) each add waited on its first
+  // prefetch, as TLB misses make it do (docs/benchmarks.md, "Results built in place").
   static constexpr size_t kChunkBytes = size_t{2} << 20;
   static constexpr size_t kBlocksPerChunk = kChunkBytes / sizeof(Block);
   struct Unmap {
