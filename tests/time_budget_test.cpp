@@ -45,7 +45,7 @@ TEST_P(TimeBudget, TwoSecondBudgetEndsWithinThreeSeconds) {
   EXPECT_EQ(stats["nonfinite_samples"], 0);
 
   const double spp = stats["spp"].get<int>(), samples_per_pixel = stats["samples_per_pixel"];
-  const bool photon_mapping = c.name.rfind("sppm", 0) == 0;
+  const bool photon_mapping = stats["integrator"] == "sppm";
   if (photon_mapping) {
     EXPECT_EQ(samples_per_pixel, spp);
   } else {

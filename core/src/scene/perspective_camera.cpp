@@ -141,13 +141,18 @@ std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Ve
   s.p_lens = Vec3(to_world_ * Vec4(lens, 1.f));
   Vec3 d = s.p_lens - p_ref;
   float dist2 = glm::dot(d, d);
-  float cos_lens = 0.f;
-  if (dist2 > 0.f) {
-    s.wi = d / std::sqrt(dist2);
-    cos_lens = std::abs(glm::dot(axis_, s.wi));
+  if (!(dist2 > 0.f)) {
+    out.reset();
+    return out;
   }
-  if (cos_lens != 0.f) s.We = We(Ray{s.p_lens, -s.wi, Infinity}, &s.p_raster);
-  if (is_black(s.We)) {  // also where dist2 or cos_lens is 0 (We stays 0)
+  s.wi = d / std::sqrt(dist2);
+  float cos_lens = std::abs(glm::dot(axis_, s.wi));
+  if (cos_lens == 0.f) {
+    out.reset();
+    return out;
+  }
+  s.We = We(Ray{s.p_lens, -s.wi, Infinity}, &s.p_raster);
+  if (is_black(s.We)) {
     out.reset();
     return out;
   }
