@@ -36,3 +36,14 @@ bench_find_build() {
 bench_python() {
   if [ -x /usr/bin/python3 ]; then echo /usr/bin/python3; else echo python3; fi
 }
+
+# "native" when the build makes code for this processor only (configured with
+# -DPENUMBRA_NATIVE_ARCH=ON, or -march=native in CMAKE_CXX_FLAGS), "x86-64" otherwise: figures from
+# the two are not comparable (docs/benchmarks.md).
+bench_build_arch() {
+  if grep -qE '^PENUMBRA_NATIVE_ARCH:BOOL=ON$|^CMAKE_CXX_FLAGS:STRING=.*-march=native' "$1/CMakeCache.txt" 2>/dev/null; then
+    echo native
+  else
+    echo x86-64
+  fi
+}

@@ -78,8 +78,9 @@ date_iso=$(date -Iseconds)
 commit=$(bench_commit "$root")
 cpu=$(bench_cpu_model)
 load=$(bench_loadavg)
+arch=$(bench_build_arch "$build")
 echo "integrators.sh: $(echo $scene_list | wc -w) scenes x $(echo $integrator_list | wc -w) integrators x $runs runs" \
-  "x ${time_budget} s, $threads threads; commit $commit; load average $load on $(nproc) cores" >&2
+  "x ${time_budget} s, $threads threads; commit $commit ($arch build); load average $load on $(nproc) cores" >&2
 
 for s in $scene_list; do
   file="$root/$(bench_scene_file "$s")"
@@ -110,5 +111,5 @@ done
 
 "$py" "$root/bench/summarise.py" --work "$work" --scenes "$(echo $scene_list)" --integrators "$integrators" \
   --runs "$runs" --time "$time_budget" --threads "$threads" --date "$date_iso" --commit "$commit" \
-  --nproc "$(nproc)" --cpu "$cpu" --load "$load" --references "$root/bench/references" \
+  --nproc "$(nproc)" --cpu "$cpu" --load "$load" --arch "$arch" --references "$root/bench/references" \
   $([ "$history" = 1 ] && echo --history "$root/bench/results/history.csv") | tee "$work/table.md"

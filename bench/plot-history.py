@@ -2,9 +2,9 @@
 """Plots bench/results/history.csv (written by bench/integrators.sh): passes per second of each
 (scene, integrator) against the run index, one panel per scene, one line per integrator, so that a
 throughput regression shows as a step. Runs are the distinct dates of the CSV in file order; the x
-axis is labelled with their commits. Only runs with the most common time budget, thread count and
-machine are plotted unless --time/--threads/--all say otherwise, since passes/s is only comparable
-between like runs.
+axis is labelled with their commits. Only runs with the most common time budget, thread count,
+machine and build architecture (x86-64 or native) are plotted unless --time/--threads/--all say
+otherwise, since passes/s is only comparable between like runs.
 
 Usage: bench/plot-history.py [--csv bench/results/history.csv] [-o bench/results/history.png]
                              [--metric passes_per_s|mrays_per_s|relmse|ratio_to_embree]
@@ -45,8 +45,8 @@ def main():
     if not rows:
         sys.exit(f"{a.csv}: no rows")
 
-    def machine(r):
-        return f"{r['nproc']} x {r['cpu']}"
+    def machine(r):  # rows from before the arch column were all portable (x86-64) builds
+        return f"{r['nproc']} x {r['cpu']}, {r.get('arch') or 'x86-64'} build"
 
     if not a.all:
         def most_common(key):

@@ -13,7 +13,7 @@ import sys
 HISTORY_FIELDS = [
     "date", "commit", "nproc", "cpu", "loadavg", "threads", "scene", "integrator", "time", "runs",
     "seconds", "passes", "passes_per_s", "mrays_per_s", "relmse", "relmse_min", "relmse_max",
-    "embree_mrays_per_s", "ratio_to_embree", "nonfinite",
+    "embree_mrays_per_s", "ratio_to_embree", "nonfinite", "arch",
 ]
 
 
@@ -29,9 +29,24 @@ def fmt(x, spec):
     return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
 
+def upgrade_history(path):
+    """Rewrites a history file written before a column was added: the new columns are empty."""
+    with open(path, newline="") as f:
+        old = list(csv.DictReader(f))
+    with open(path, newline="") as f:
+        header = next(csv.reader(f), [])
+    if header == HISTORY_FIELDS:
+        return
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=HISTORY_FIELDS)
+        w.writeheader()
+        for r in old:
+            w.writerow({k: r.get(k, "") or "" for k in HISTORY_FIELDS})
+
+
 def main():
     ap = argparse.ArgumentParser()
-    for name in ["work", "scenes", "integrators", "date", "commit", "cpu", "load", "references"]:
+    for name in ["work", "scenes", "integrators", "date", "commit", "cpu", "load", "references", "arch"]:
         ap.add_argument("--" + name, required=True)
     ap.add_argument("--runs", type=int, required=True)
     ap.add_argument("--time", type=float, required=True)
@@ -81,10 +96,10 @@ def main():
                 relmse_min=float(f"{min(rel):.5g}") if rel else None,
                 relmse_max=float(f"{max(rel):.5g}") if rel else None,
                 embree_mrays_per_s=None if embree_mix is None else round(embree_mix, 3),
-                ratio_to_embree=None if ratio is None else round(ratio, 4), nonfinite=nonfinite))
+                ratio_to_embree=None if ratio is None else round(ratio, 4), nonfinite=nonfinite, arch=a.arch))
 
     out = sys.stdout
-    out.write(f"\n{a.date}, commit {a.commit}, {a.nproc} x {a.cpu}, load average {a.load} at start; "
+    out.write(f"\n{a.date}, commit {a.commit} ({a.arch} build), {a.nproc} x {a.cpu}, load average {a.load} at start; "
               f"{a.time:g} s per render, {a.threads} threads, {a.runs} run(s)\n\n")
     out.write("| scene | integrator | passes | passes/s | Mrays/s | relMSE (median [min, max]) | vs Embree | non-finite |\n")
     out.write("|---|---|---|---|---|---|---|---|\n")
@@ -106,6 +121,8 @@ def main():
     if a.history:
         os.makedirs(os.path.dirname(a.history), exist_ok=True)
         new = not os.path.exists(a.history) or os.path.getsize(a.history) == 0
+        if not new:
+            upgrade_history(a.history)
         with open(a.history, "a", newline="") as f:
             w = csv.DictWriter(f, fieldnames=HISTORY_FIELDS)
             if new:
