@@ -32,11 +32,10 @@ def fmt(x, spec):
 def upgrade_history(path):
     """Rewrites a history file written before a column was added: the new columns are empty."""
     with open(path, newline="") as f:
-        old = list(csv.DictReader(f))
-    with open(path, newline="") as f:
-        header = next(csv.reader(f), [])
-    if header == HISTORY_FIELDS:
-        return
+        reader = csv.DictReader(f)
+        if reader.fieldnames == HISTORY_FIELDS:
+            return
+        old = list(reader)
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=HISTORY_FIELDS)
         w.writeheader()

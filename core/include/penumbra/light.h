@@ -52,6 +52,19 @@ struct LightLiSample {
   Vec3 n_light{0.f};  // its normal (zero for points not on a surface)
 };
 
+/// Makes `out` hold a light sample, built in place: the LightLiSample counterpart of
+/// emplace_sample() in penumbra/bsdf.h (sample_li() keeps one optional, returns it by name on every
+/// path and fills it with this, so the result is not copied out of a stack temporary).
+inline void emplace_li_sample(std::optional<LightLiSample>& out, const Rgb& L, const Vec3& wi, float pdf,
+                              const Vec3& p_light, const Vec3& n_light = Vec3(0.f)) {
+  LightLiSample& s = out.emplace();
+  s.L = L;
+  s.wi = wi;
+  s.pdf = pdf;
+  s.p_light = p_light;
+  s.n_light = n_light;
+}
+
 /// A ray leaving a light, for methods that trace paths from the lights (light tracing, bidirectional
 /// path tracing, photon mapping).
 struct LightLeSample {

@@ -135,29 +135,24 @@ void PerspectiveCamera::pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) c
 std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Vec2 u) const {
   Vec3 lens(0.f);
   if (lens_radius_ > 0.f) lens = Vec3(lens_radius_ * sample_uniform_disk_concentric(u), 0.f);
-  // The one object every path returns, built where the caller receives it (no copy out).
+  // The one object every path returns, filled where the caller receives it (no copy out).
   std::optional<CameraWiSample> out;
-  CameraWiSample& s = out.emplace();
-  s.p_lens = Vec3(to_world_ * Vec4(lens, 1.f));
-  Vec3 d = s.p_lens - p_ref;
+  Vec3 p_lens = Vec3(to_world_ * Vec4(lens, 1.f));
+  Vec3 d = p_lens - p_ref;
   float dist2 = glm::dot(d, d);
-  if (!(dist2 > 0.f)) {
-    out.reset();
-    return out;
-  }
-  s.wi = d / std::sqrt(dist2);
-  float cos_lens = std::abs(glm::dot(axis_, s.wi));
-  if (cos_lens == 0.f) {
-    out.reset();
-    return out;
-  }
-  s.We = We(Ray{s.p_lens, -s.wi, Infinity}, &s.p_raster);
-  if (is_black(s.We)) {
-    out.reset();
-    return out;
-  }
-  // Uniform by lens area, converted to solid angle at the reference point.
-  s.pdf = dist2 / (cos_lens * lens_area_);
+  if (!(dist2 > 0.f)) return out;
+  Vec3 wi = d / std::sqrt(dist2);
+  float cos_lens = std::abs(glm::dot(axis_, wi));
+  if (cos_lens == 0.f) return out;
+  Vec2 p_raster(0.f);
+  Rgb importance = We(Ray{p_lens, -wi, Infinity}, &p_raster);
+  if (is_black(importance)) return out;
+  CameraWiSample& s = out.emplace();
+  s.p_lens = p_lens;
+  s.wi = wi;
+  s.We = importance;
+  s.p_raster = p_raster;
+  s.pdf = dist2 / (cos_lens * lens_area_);  // uniform by lens area, converted to solid angle at p_ref
   return out;
 }
 

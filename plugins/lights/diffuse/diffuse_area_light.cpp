@@ -27,7 +27,7 @@ class DiffuseAreaLight final : public Light {
   }
 
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
-    std::optional<LightLiSample> ls;  // returned by name on every path (why: emplace_sample(), penumbra/bsdf.h)
+    std::optional<LightLiSample> ls;  // returned by name on every path (emplace_li_sample())
     std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, u);
     if (!ss || !(ss->pdf > 0.f) || !shape_->present(*ss)) return ls;
     Vec3 d = ss->p - ctx.p;
@@ -36,12 +36,7 @@ class DiffuseAreaLight final : public Light {
     Vec3 wi = d / len;
     Rgb Le = L(ss->p, ss->n, ss->uv, -wi);
     if (is_black(Le)) return ls;
-    ls.emplace();
-    ls->L = Le;
-    ls->wi = wi;
-    ls->pdf = ss->pdf;
-    ls->p_light = ss->p;
-    ls->n_light = ss->n;
+    emplace_li_sample(ls, Le, wi, ss->pdf, ss->p, ss->n);
     return ls;
   }
 

@@ -64,14 +64,10 @@ class InfiniteLight final : public Light {
   Rgb Le(const Ray& ray) const override { return radiance(to_light_ * glm::normalize(ray.d)); }
 
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
-    std::optional<LightLiSample> ls;  // the one object every path returns, filled by set()
-    // A target outside the scene's bounding sphere, so a shadow ray tests all geometry.
+    std::optional<LightLiSample> ls;  // returned by name on every path (emplace_li_sample())
+    // The target is outside the scene's bounding sphere, so a shadow ray tests all geometry.
     auto set = [&](const Rgb& L, const Vec3& wi, float pdf) {
-      ls.emplace();
-      ls->L = L;
-      ls->wi = wi;
-      ls->pdf = pdf;
-      ls->p_light = ctx.p + wi * (2.f * radius_);
+      emplace_li_sample(ls, L, wi, pdf, ctx.p + wi * (2.f * radius_));
     };
     Vec3 w_light;
     float pdf;

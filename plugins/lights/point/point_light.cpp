@@ -19,15 +19,11 @@ class PointLight final : public Light {
   LightType type() const override { return LightType::DeltaPosition; }
   Rgb power() const override { return 4.f * Pi * I_; }
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2) const override {
-    std::optional<LightLiSample> ls;  // returned by name on every path (why: emplace_sample(), penumbra/bsdf.h)
+    std::optional<LightLiSample> ls;  // returned by name on every path (emplace_li_sample())
     Vec3 d = p_ - ctx.p;
     float dist2 = glm::dot(d, d);
     if (dist2 == 0.f) return ls;  // a point light on the receiving point delivers nothing finite
-    ls.emplace();
-    ls->L = I_ / dist2;
-    ls->wi = d / std::sqrt(dist2);
-    ls->pdf = 1.f;
-    ls->p_light = p_;
+    emplace_li_sample(ls, I_ / dist2, d / std::sqrt(dist2), 1.f, p_);
     return ls;
   }
   float pdf_li(const LightSampleContext&, const Vec3&, const SurfaceInteraction&) const override { return 0.f; }
