@@ -34,7 +34,8 @@ build_target() {
     ply) "$cxx" "${flags[@]}" core/src/parser/ply_reader.cpp "${common[@]}" tests/fuzz/ply_fuzzer.cpp -lfmt -o "$2" ;;
     gltf) "$cxx" "${flags[@]}" core/src/scene/gltf_loader.cpp "${common[@]}" tests/fuzz/gltf_fuzzer.cpp \
             -ltinygltf -lfmt -o "$2" ;;
-    image) "$cxx" "${flags[@]}" $(pkg-config --cflags OpenImageIO OpenColorIO) core/src/image/image_io.cpp core/src/image/image_input.cpp \
+    image) "$cxx" "${flags[@]}" $(pkg-config --cflags OpenImageIO OpenColorIO) core/src/image/image_io.cpp \
+             core/src/image/image_codecs.cpp core/oiio/oiio_codecs.cpp \
              core/src/util/sampling.cpp "${common[@]}" tests/fuzz/image_fuzzer.cpp \
              $(pkg-config --libs OpenImageIO OpenColorIO) -lfmt -o "$2" ;;
     *) echo "fuzz.sh: unknown target '$1' (parser, ply, gltf, image)" >&2; exit 2 ;;

@@ -116,6 +116,39 @@ TEST(Loading, NoInstalledBinaryOrPluginHasAnEmptyOrRelativeRunpathEntry) {
   std::string out = run("'" + prefix + "/bin/penumbra' plugins 2>&1");
   EXPECT_THAT(out, HasSubstr("integrator 'path'"));
   EXPECT_THAT(out, HasSubstr(prefix + "/lib/penumbra/plugins"));
+  // ... and the core its image library beside itself: an EXR and a PNG are written.
+  std::string scene = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
+  std::string render = "'" + prefix + "/bin/penumbra' render '" + scene + "' --spp 1 --res 8x8 -q -o '" + prefix;
+  for (const char* name : {"/o.exr", "/o.png"}) {
+    out = run(render + name + "' 2>&1; echo rc=$?");
+    EXPECT_THAT(out, HasSubstr("rc=0")) << out;
+    EXPECT_TRUE(fs::is_regular_file(prefix + name)) << name;
+  }
+  // Without the image library the render is refused before it starts, naming what is missing.
+  fs::remove(prefix + "/lib/penumbra/libpenumbra-oiio.so");
+  out = run(render + "/p.exr' 2>&1; echo rc=$?");
+  EXPECT_THAT(out, HasSubstr("-o: cannot write image '" + prefix + "/p.exr': Penumbra's image library '" + prefix +
+                             "/lib/penumbra/libpenumbra-oiio.so' is missing: reinstall Penumbra"));
+  EXPECT_THAT(out, HasSubstr("rc=1"));
+  EXPECT_THAT(out, Not(HasSubstr("rendered in")));
+}
+
+// Image files go through OpenImageIO in a library the core opens on first use
+// (core/src/image/image_codecs.h): a process that reads and writes no image file does not load
+// OpenImageIO and the ~260 shared libraries it links; one that writes its render does.
+TEST(Loading, OnlyAProcessThatTouchesAnImageFileLoadsOpenImageIO) {
+  std::string dir = test::temp_dir("lazy-image-library");
+  std::string bin = "'" + std::string(PENUMBRA_BINARY) + "'";
+  std::string listed = run("LD_DEBUG=files " + bin + " plugins 2>&1 >/dev/null");
+  ASSERT_THAT(listed, HasSubstr("libpenumbra-core.so")) << "LD_DEBUG traced nothing";
+  EXPECT_THAT(listed, HasSubstr("penumbra-texture-imagemap.so"));
+  EXPECT_THAT(listed, Not(HasSubstr("libOpenImageIO")));
+  std::string scene = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
+  std::string rendered = run("LD_DEBUG=files " + bin + " render '" + scene + "' --spp 1 --res 8x8 -q -o '" + dir +
+                             "/o.exr' 2>&1 >/dev/null");
+  EXPECT_THAT(rendered, HasSubstr("lib/penumbra/libpenumbra-oiio.so"));
+  EXPECT_THAT(rendered, HasSubstr("libOpenImageIO"));
+  EXPECT_TRUE(fs::is_regular_file(dir + "/o.exr"));
 }
 
 TEST(Loading, ALibraryPlantedInTheCurrentFolderIsNotLoaded) {

@@ -1,12 +1,9 @@
 #include "image/exr_layers.h"
 
-#include "image/image_input.h"
-
-#include "util/output_file.h"
+#include "image/image_codecs.h"
 
 #include <penumbra/error.h>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/core.h>
 
 namespace penumbra {
@@ -43,11 +40,12 @@ void write_layered_exr(const std::string& path, const LayeredImage& image) {
   }
   if (names.empty() || npix == 0) throw Error(fmt::format("cannot write image '{}': it is empty", path));
 
-  OIIO::ImageSpec spec(image.width, image.height, int(names.size()), OIIO::TypeDesc::FLOAT);
-  spec.channelnames = names;
-  spec.alpha_channel = -1;
-  spec.attribute("compression", "zip");
-  for (const auto& [key, value] : image.metadata) spec.attribute(key, value);
+  RasterToWrite raster;
+  raster.width = image.width;
+  raster.height = image.height;
+  raster.channel_names = names;
+  raster.attributes = {{"compression", "zip"}};
+  raster.attributes.insert(raster.attributes.end(), image.metadata.begin(), image.metadata.end());
 
   std::vector<float> buffer(npix * names.size());
   size_t offset = 0;
@@ -57,27 +55,20 @@ void write_layered_exr(const std::string& path, const LayeredImage& image) {
       for (size_t c = 0; c < n; ++c) buffer[p * names.size() + offset + c] = l.pixels[p * n + c];
     offset += n;
   }
-  // Through a temporary file renamed into place: the old image survives a failure.
-  write_atomically(path, [&](const std::string& temporary) {
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, OIIO::geterror()));
-    if (!out->open(temporary, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, buffer.data()) || !out->close())
-      throw Error(fmt::format("cannot write image '{}': {}", path, out->geterror()));
-  });
+  raster.floats = buffer.data();
+  write_raster(path, raster);
 }
 
 LayeredImage read_layered_exr(const std::string& path) {
-  auto in = open_image_input(path);
-  const OIIO::ImageSpec& spec = in->spec();
-  size_t nch = size_t(spec.nchannels), npix = size_t(spec.width) * size_t(spec.height);
-  std::vector<float> all = read_image_channels(*in, path, spec.nchannels);
+  RasterRead r = read_raster(path, 64);
+  size_t nch = r.channel_names.size(), npix = size_t(r.width) * size_t(r.height);
 
   LayeredImage image;
-  image.width = spec.width;
-  image.height = spec.height;
+  image.width = r.width;
+  image.height = r.height;
   std::vector<std::pair<size_t, size_t>> where(nch);  // channel -> (layer, index in layer)
   for (size_t c = 0; c < nch; ++c) {
-    std::string full = spec.channelnames[c];
+    const std::string& full = r.channel_names[c];
     size_t dot = full.rfind('.');
     std::string layer = dot == std::string::npos ? "" : full.substr(0, dot);
     std::string channel = dot == std::string::npos ? full : full.substr(dot + 1);
@@ -91,11 +82,9 @@ LayeredImage read_layered_exr(const std::string& path) {
   for (size_t p = 0; p < npix; ++p)
     for (size_t c = 0; c < nch; ++c) {
       ImageLayer& l = image.layers[where[c].first];
-      l.pixels[p * l.channels.size() + where[c].second] = all[p * nch + c];
+      l.pixels[p * l.channels.size() + where[c].second] = r.pixels[p * nch + c];
     }
-  for (const auto& attr : spec.extra_attribs)
-    if (attr.type() == OIIO::TypeDesc::STRING) image.metadata.emplace_back(attr.name().string(), attr.get_string());
-  in->close();
+  image.metadata = std::move(r.attributes);
   return image;
 }
 

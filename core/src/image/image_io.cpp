@@ -1,13 +1,12 @@
 #include "image/image_io.h"
 
-#include "image/image_input.h"
+#include "image/image_codecs.h"
 
 #include "util/output_file.h"
 
 #include <penumbra/error.h>
 
 #include <OpenColorIO/OpenColorIO.h>
-#include <OpenImageIO/imageio.h>
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -138,17 +137,7 @@ std::vector<uint8_t> encode_for_display(const std::string& path, const ImageRgb&
   return bytes;
 }
 
-// ---- OpenImageIO ---------------------------------------------------------------------------------
-
-// Through a temporary file renamed into place (util/output_file.h): the old image survives a failure.
-void write_pixels(const std::string& path, const OIIO::ImageSpec& spec, const void* data) {
-  write_atomically(path, [&](const std::string& temporary) {
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, OIIO::geterror()));
-    if (!out->open(temporary, spec) || !out->write_image(spec.format, data) || !out->close())
-      throw Error(fmt::format("cannot write image '{}': {}", path, out->geterror()));
-  });
-}
+// ---- PFM -----------------------------------------------------------------------------------------
 
 // OpenImageIO 2.4 reads PFM but cannot write it, and the format is a header plus raw floats.
 void write_pfm_to(const std::string& path, const std::string& temporary, const ImageRgb& img) {
@@ -183,8 +172,11 @@ std::string image_output_problem(const std::string& path) {
     const FormatInfo& format = format_of(path);
     std::string problem = output_path_problem(path);
     if (!problem.empty()) return fmt::format("cannot write image '{}': {}", path, problem);
-    // 8-bit formats need a usable OpenColorIO config: find that out now, not after the render.
+    // 8-bit formats need a usable OpenColorIO config, and all but PFM the image library: find that
+    // out now, not after the render.
     if (format.encoding == Encoding::Display) current_config();
+    if (std::string(format.extension) != ".pfm") problem = image_codecs_problem();
+    if (!problem.empty()) return fmt::format("cannot write image '{}': {}", path, problem);
   } catch (const Error& e) {
     return e.what();
   }
@@ -206,42 +198,43 @@ void write_image(const std::string& path, const ImageRgb& img,
                                                                    size_t(std::max(img.height, 0)) * 3));
 
   bool display = format.encoding == Encoding::Display;
-  OIIO::ImageSpec spec(img.width, img.height, 3, display ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
-  for (const auto& [key, value] : metadata) spec.attribute(key, value);
   std::string ext = format.extension;
-  if (ext == ".exr") spec.attribute("compression", "zip");
-  if (ext == ".jpg" || ext == ".jpeg") spec.attribute("Compression", "jpeg:95");
-
   if (ext == ".pfm") {
     write_pfm(path, img);
-  } else if (display) {
-    std::vector<uint8_t> bytes = encode_for_display(path, img, view);
-    write_pixels(path, spec, bytes.data());
-  } else {
-    write_pixels(path, spec, img.pixels.data());
+    return;
   }
+  RasterToWrite raster;
+  raster.width = img.width;
+  raster.height = img.height;
+  raster.channel_names = {"R", "G", "B"};
+  raster.attributes = metadata;
+  if (ext == ".exr") raster.attributes.emplace_back("compression", "zip");
+  if (ext == ".jpg" || ext == ".jpeg") raster.attributes.emplace_back("Compression", "jpeg:95");
+  std::vector<uint8_t> bytes;
+  if (display) {
+    bytes = encode_for_display(path, img, view);
+    raster.bytes = bytes.data();
+  } else {
+    raster.floats = img.pixels.data();
+  }
+  write_raster(path, raster);
 }
 
 ImageRgb read_image(const std::string& path, ImageFileInfo* info) {
-  auto in = open_image_input(path);
-  const OIIO::ImageSpec& spec = in->spec();
-  int channels = spec.nchannels;
-  if (info) {
-    info->integer = !spec.format.is_floating_point();
-    info->channels = channels;
-  }
   // Only the channels used: the first three, or the one grey channel repeated.
-  int used = std::min(channels, 3);
-  std::vector<float> all = read_image_channels(*in, path, used);
-  in->close();
-
+  RasterRead r = read_raster(path, 3);
+  if (info) {
+    info->integer = r.integer;
+    info->channels = r.file_channels;
+  }
+  size_t used = r.channel_names.size();
   ImageRgb img;
-  img.width = spec.width;
-  img.height = spec.height;
+  img.width = r.width;
+  img.height = r.height;
   img.pixels.resize(size_t(img.width) * img.height * 3);
   for (size_t p = 0; p < size_t(img.width) * img.height; ++p)
-    for (int c = 0; c < 3; ++c)
-      img.pixels[3 * p + c] = all[p * used + (used == 3 ? c : 0)];
+    for (size_t c = 0; c < 3; ++c)
+      img.pixels[3 * p + c] = r.pixels[p * used + (used == 3 ? c : 0)];
   return img;
 }
 

@@ -1,9 +1,11 @@
-#include "image/image_input.h"
-
-#include "util/input_file.h"
+// libpenumbra-oiio.so: the image codecs of core/src/image/image_codecs.h through OpenImageIO, in a
+// library of their own so that only a process that reads or writes an image file loads OpenImageIO
+// and the shared libraries it links.
+#include "image/image_codecs.h"
 
 #include <penumbra/error.h>
 
+#include <OpenImageIO/imageio.h>
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -21,11 +23,20 @@ void use_openexr_core_reader() {
   (void)done;
 }
 
-}  // namespace
+void write(const std::string& path, const std::string& temporary, const RasterToWrite& r) {
+  OIIO::ImageSpec spec(r.width, r.height, int(r.channel_names.size()),
+                       r.floats ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  spec.channelnames = r.channel_names;
+  spec.alpha_channel = -1;  // "A" among AOV layers is not an alpha to premultiply by
+  for (const auto& [key, value] : r.attributes) spec.attribute(key, value);
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw Error(fmt::format("cannot write image '{}': {}", path, OIIO::geterror()));
+  const void* data = r.floats ? static_cast<const void*>(r.floats) : static_cast<const void*>(r.bytes);
+  if (!out->open(temporary, spec) || !out->write_image(spec.format, data) || !out->close())
+    throw Error(fmt::format("cannot write image '{}': {}", path, out->geterror()));
+}
 
-std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path) {
-  if (std::string problem = input_file_problem(path); !problem.empty())
-    throw Error(fmt::format("cannot read image '{}': {}", path, problem));
+std::unique_ptr<OIIO::ImageInput> open_checked(const std::string& path) {
   use_openexr_core_reader();
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
@@ -41,7 +52,10 @@ std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path) {
   return in;
 }
 
-std::vector<float> read_image_channels(OIIO::ImageInput& in, const std::string& path, int channels) {
+// The result grows with the rows actually decoded, in bands of at least 64 rows (whole tile rows
+// for a tiled file), so a header that claims a huge image in a small or damaged file fails at its
+// first bad band instead of making the reader allocate the claimed size first.
+std::vector<float> read_channels(OIIO::ImageInput& in, const std::string& path, int channels) {
   const OIIO::ImageSpec& spec = in.spec();
   const size_t row = size_t(spec.width) * size_t(channels);
   const bool tiled = spec.tile_width > 0 && spec.tile_height > 0;
@@ -60,4 +74,29 @@ std::vector<float> read_image_channels(OIIO::ImageInput& in, const std::string& 
   return pixels;
 }
 
+RasterRead read(const std::string& path, int max_channels) {
+  auto in = open_checked(path);
+  const OIIO::ImageSpec& spec = in->spec();
+  RasterRead r;
+  r.width = spec.width;
+  r.height = spec.height;
+  r.file_channels = spec.nchannels;
+  r.integer = !spec.format.is_floating_point();
+  int n = std::clamp(max_channels, 1, spec.nchannels);
+  for (int c = 0; c < n; ++c) r.channel_names.push_back(c < int(spec.channelnames.size()) ? spec.channelnames[c] : "");
+  r.pixels = read_channels(*in, path, n);
+  for (const auto& attr : spec.extra_attribs)
+    if (attr.type() == OIIO::TypeDesc::STRING) r.attributes.emplace_back(attr.name().string(), attr.get_string());
+  in->close();
+  return r;
+}
+
+const ImageCodecs kCodecs{kImageCodecsVersion, write, read};
+
+}  // namespace
+
 }  // namespace penumbra
+
+extern "C" __attribute__((visibility("default"))) const penumbra::ImageCodecs* penumbra_image_codecs() {
+  return &penumbra::kCodecs;
+}
