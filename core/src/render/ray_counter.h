@@ -6,7 +6,10 @@
 namespace penumbra {
 
 void count_rays_slow_path();
-struct ThreadRayCount {
+// A cache line each: two threads' counters in one line (8-byte heap blocks, allocated one after the
+// other) made every ray a write to a line the other core also writes, which cost the path tracer
+// 30 % of its speed on 2 threads whenever the heap's layout put them together (docs/benchmarks.md).
+struct alignas(64) ThreadRayCount {
   uint64_t rays = 0;
 };
 // Initial-exec TLS: libpenumbra-core is loaded with the program (never dlopen'ed), so the counter
