@@ -223,8 +223,8 @@ std::vector<Variant> all_variants() {
   return v;
 }
 
-// Jump-ahead (a table for short jumps, Brown's loop beyond) lands where stepping lands, on several
-// streams, for every short length and a few long ones (the sample-index jumps).
+// Jump-ahead (a table for short jumps, one table step per higher set bit beyond) lands where stepping
+// lands, on several streams, for every short length and a few long ones (the sample-index jumps).
 TEST(Pcg32, AdvanceEqualsSteppingForShortAndLongJumps) {
   for (uint64_t stream : {0ull, 1ull, 0x9e3779b97f4a7c15ull}) {
     std::vector<uint64_t> lengths;
@@ -236,6 +236,25 @@ TEST(Pcg32, AdvanceEqualsSteppingForShortAndLongJumps) {
       for (uint64_t i = 0; i < n; ++i) stepped.next_u32();
       ASSERT_EQ(jumped.next_u32(), stepped.next_u32()) << "stream " << stream << ", jump " << n;
       ASSERT_EQ(jumped.next_u32(), stepped.next_u32()) << "stream " << stream << ", jump " << n;
+    }
+  }
+}
+
+// Jumps too long to step: the generator's period is 2^64, so 2^64 - 1 outputs (every power-of-two
+// jump) and one more return to the start; and two long jumps land where their sum lands.
+TEST(Pcg32, LongJumpsComposeAndTheFullPeriodReturnsToTheStart) {
+  for (uint64_t stream : {0ull, 1ull, 0x9e3779b97f4a7c15ull}) {
+    Pcg32 start(stream, 42), around(stream, 42);
+    around.advance(~0ull);
+    around.next_u32();
+    for (int i = 0; i < 4; ++i) ASSERT_EQ(around.next_u32(), start.next_u32()) << "stream " << stream;
+    for (auto [a, b] : {std::pair<uint64_t, uint64_t>{65536ull * 1000, 65536ull * 24},
+                        {0xfffffffeull << 16, 0x12345ull}, {1ull << 63, (1ull << 63) + 977}}) {
+      Pcg32 two(stream, 7), one(stream, 7);
+      two.advance(a);
+      two.advance(b);
+      one.advance(a + b);
+      ASSERT_EQ(two.next_u32(), one.next_u32()) << "stream " << stream << ", jumps " << a << " + " << b;
     }
   }
 }

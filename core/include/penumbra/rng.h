@@ -5,6 +5,7 @@
 #include <penumbra/math.h>
 
 #include <array>
+#include <bit>
 #include <cstdint>
 
 namespace penumbra {
@@ -54,21 +55,14 @@ class Pcg32 {
 
   /// Skips `delta` outputs in O(log delta) (Brown's algorithm).
   void advance(uint64_t delta) {
-    if (delta < kJumps.size()) {  // short jumps (a sampler's dimensions): one step from a table
-      state_ = kJumps[delta].mult * state_ + kJumps[delta].inc_factor * inc_;
-      return;
+    // The low 8 bits of the jump in one step from kJumps, then each higher set bit k in one step
+    // from kPow2Jumps: a sample-index jump (index * 2^16) costs one step per set bit of the index.
+    const Jump& low = kJumps[delta & 255u];
+    state_ = low.mult * state_ + low.inc_factor * inc_;
+    for (uint64_t high = delta >> 8u; high; high &= high - 1u) {
+      const Jump& j = kPow2Jumps[8 + std::countr_zero(high)];
+      state_ = j.mult * state_ + j.inc_factor * inc_;
     }
-    uint64_t cur_mult = kMult, cur_plus = inc_, acc_mult = 1u, acc_plus = 0u;
-    while (delta > 0) {
-      if (delta & 1) {
-        acc_mult *= cur_mult;
-        acc_plus = acc_plus * cur_mult + cur_plus;
-      }
-      cur_plus = (cur_mult + 1) * cur_plus;
-      cur_mult *= cur_mult;
-      delta /= 2;
-    }
-    state_ = acc_mult * state_ + acc_plus;
   }
 
  private:
@@ -76,6 +70,7 @@ class Pcg32 {
   // n steps of state' = kMult state + inc make state_n = mult_n state + inc_factor_n inc, where
   // mult_n = kMult^n and inc_factor_n = 1 + kMult + ... + kMult^(n-1) (mod 2^64) do not depend on
   // the stream: advance() skips up to 255 outputs with two multiplications instead of a loop.
+  // Jumps of any lengths commute (they are powers of the same step), so they apply in any order.
   struct Jump {
     uint64_t mult, inc_factor;
   };
@@ -86,6 +81,17 @@ class Pcg32 {
       j = Jump{mult, inc_factor};
       inc_factor = inc_factor * kMult + 1u;
       mult *= kMult;
+    }
+    return t;
+  }();
+  // Jumps of 2^k outputs: doubling n gives mult_2n = mult_n^2, inc_factor_2n = inc_factor_n (mult_n + 1).
+  static constexpr std::array<Jump, 64> kPow2Jumps = [] {
+    std::array<Jump, 64> t{};
+    uint64_t mult = kMult, inc_factor = 1u;
+    for (Jump& j : t) {
+      j = Jump{mult, inc_factor};
+      inc_factor *= mult + 1u;
+      mult *= mult;
     }
     return t;
   }();
