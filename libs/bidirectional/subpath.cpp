@@ -686,10 +686,6 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
     cam.kind = VertexKind::Camera;
     cam.p = cw->p_lens;
     cam.beta = cw->We / cw->pdf;
-    float pdf_pos, pdf_dir;
-    scene.camera().pdf_we(Ray{cam.p, -cw->wi}, &pdf_pos, &pdf_dir);
-    cam.pdf_fwd = pdf_pos;
-    c.has_sampled = true;
     if (qs.kind == VertexKind::Surface)
       c.L = qs.beta * qs.f(cam) * cam.beta * std::abs(glm::dot(cw->wi, qs.ns));
     else  // a point on an area light seen directly (light tracing's s = 1)
@@ -702,6 +698,11 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       c.L = Rgb(0.f);
       return c;
     }
+    // The lens vertex's densities only once the connection counts (a blocked one skips them).
+    float pdf_pos, pdf_dir;
+    scene.camera().pdf_we(Ray{cam.p, -cw->wi}, &pdf_pos, &pdf_dir);
+    cam.pdf_fwd = pdf_pos;
+    c.has_sampled = true;
     c.splat = true;
     c.p_raster = cw->p_raster;
     if (!weighted || s + t == 2) {
