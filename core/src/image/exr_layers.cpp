@@ -60,7 +60,7 @@ void write_layered_exr(const std::string& path, const LayeredImage& image) {
 }
 
 LayeredImage read_layered_exr(const std::string& path) {
-  RasterRead r = read_raster(path, 64);
+  RasterRead r = read_raster(path, kMaxImageChannels);
   size_t nch = r.channel_names.size(), npix = size_t(r.width) * size_t(r.height);
 
   LayeredImage image;

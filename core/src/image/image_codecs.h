@@ -43,12 +43,13 @@ struct ImageCodecs {
   /// caller renames it to `path`). Throws Error naming `path`.
   void (*write)(const std::string& path, const std::string& temporary, const RasterToWrite& raster);
   /// Reads channels [0, min(file channels, max_channels)). Throws Error naming `path` when the file
-  /// cannot be decoded, or when its header claims more than 2^28 pixels, more than 64 channels or a
-  /// volume (a damaged or hostile header must not make anyone allocate).
+  /// cannot be decoded, or when its header claims more than 2^28 pixels, more than kMaxImageChannels
+  /// channels or a volume (a damaged or hostile header must not make anyone allocate).
   RasterRead (*read)(const std::string& path, int max_channels);
 };
 
 constexpr int kImageCodecsVersion = 1;
+constexpr int kMaxImageChannels = 64;  // a file with more is refused as damaged or hostile
 constexpr const char* kImageCodecsSymbol = "penumbra_image_codecs";
 constexpr const char* kImageCodecsLibrary = "penumbra/libpenumbra-oiio.so";  // relative to the core's folder
 
