@@ -178,7 +178,7 @@ const std::vector<std::pair<std::string, std::string>>& combinations() {
       {"hrr-only-connections", R"("bool hrr" true "float hrrmaxalpha" 1 "bool connect" false)"},
       {"pc-only-connections", R"("bool probconnect" true "bool connect" false)"},
       {"hrr+pc-no-connect-no-lighttrace", R"("bool hrr" true "float hrrmaxalpha" 1 "bool probconnect" true "bool connect" false "bool lighttrace" false)"},
-      {"hrr-balance", R"("bool hrr" true "float hrrmaxalpha" 1 "string misheuristic" "balance")"},
+      {"hrr-power", R"("bool hrr" true "float hrrmaxalpha" 1 "string misheuristic" "power")"},
       {"hrr+pc-no-nextevent", R"("bool hrr" true "float hrrmaxalpha" 1 "bool probconnect" true "bool nextevent" false)"},
       {"hrr-glossy-only", R"("bool hrr" true "float hrrmaxalpha" 0.3)"},
   };

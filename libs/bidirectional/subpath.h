@@ -115,7 +115,7 @@ inline Vec3 direction_to(const Vertex& from, const Vertex& to) {
 struct Config {
   int max_depth = 5;  // bounces: strategies with s + t - 2 <= max_depth
   int rr_depth = 3;   // bounces of a subpath before Russian roulette may end it
-  MisHeuristic heuristic = MisHeuristic::Power;
+  MisHeuristic heuristic = MisHeuristic::Balance;  // bdpt's default (docs/bdpt.md)
   // light_subpath() fills Vertex::nee_ratio and the folded sums (Vertex::mis_sum): every weighted
   // connection needs them; unweighted light tracing does not.
   bool store_nee_ratio = true;

@@ -5,7 +5,7 @@
 //   s = 1       next-event estimation with the light's own sample_li();
 //   t = 1       the light subpath connects to the lens (camera sample_wi) and splats on the film;
 //   s, t >= 2   a shadow ray joins light vertex s-1 and camera vertex t-1.
-// The strategies are combined by MIS (power heuristic by default) computed from the path's forward
+// The strategies are combined by MIS (balance heuristic by default, as pbrt-v3 and v4) computed from the path's forward
 // and reverse densities (mis.h, subpath.h: formulation and reasons). Delta lights and specular
 // lobes are never connected to; environment and distant lights are directions whose emitted paths
 // start on a disk covering the scene. Subpaths use Russian roulette after rrdepth bounces (kept out of
@@ -16,7 +16,7 @@
 // | integer maxdepth         | 5       | longest path in bounces (pbrt's convention, as "path") |
 // | integer rrdepth          | 3       | bounces of a subpath before Russian roulette           |
 // | string lightsampler      | power   | light choice: power or uniform                         |
-// | string misheuristic      | power   | power (beta = 2) or balance                            |
+// | string misheuristic      | balance | balance or power (beta = 2); docs/bdpt.md: why balance |
 // | bool visualizestrategies | false   | write each strategy's contribution, weighted and not   |
 // | bool visualizeweights    | false   | write each strategy's mean MIS weight                  |
 // | string visualizeprefix   | bdpt_   | path prefix of those images                            |
@@ -318,7 +318,7 @@ const ParamSpec kParams[] = {
     {"integer", "maxdepth", "5", "longest path in bounces"},
     {"integer", "rrdepth", "3", "bounces of a subpath before Russian roulette may end it"},
     {"string", "lightsampler", "power", "light selection: power or uniform"},
-    {"string", "misheuristic", "power", "MIS heuristic: power or balance"},
+    {"string", "misheuristic", "balance", "MIS heuristic: balance or power"},
     {"bool", "visualizestrategies", "false", "write each strategy's contribution (weighted and unweighted)"},
     {"bool", "visualizeweights", "false", "write each strategy's mean MIS weight"},
     {"string", "visualizeprefix", "bdpt_", "path prefix of the strategy images"},
@@ -343,7 +343,7 @@ Object* create(const CreateContext& ctx) {
   Config config = read_subpath_config(p, &uniform_lights);
   std::string h = p.get_string("misheuristic");
   if (h != "power" && h != "balance")
-    throw Error(p.loc_of("misheuristic"), "misheuristic '" + h + "' is not supported; available: power, balance");
+    throw Error(p.loc_of("misheuristic"), "misheuristic '" + h + "' is not supported; available: balance, power");
   config.heuristic = h == "power" ? MisHeuristic::Power : MisHeuristic::Balance;
   TechniqueSet techniques;
   techniques.connect = p.get_bool("connect");
