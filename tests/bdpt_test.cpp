@@ -490,8 +490,9 @@ TEST(Bdpt, MaxDepthTruncatesSeriesExactly) {
       double tol = 4.0 * se + 1e-6;
       EXPECT_NEAR(mean, series(depth), tol) << integrator << " maxdepth " << depth;
       EXPECT_GT(std::abs(mean - series(depth + 1)), tol) << integrator << " maxdepth " << depth << " vs " << depth + 1;
-      if (depth > 0)
+      if (depth > 0) {
         EXPECT_GT(std::abs(mean - series(depth - 1)), tol) << integrator << " maxdepth " << depth << " vs " << depth - 1;
+      }
     }
 }
 

@@ -332,7 +332,9 @@ TEST(Sppm, FurnaceMatchesTruncatedSeriesAtEveryDepth) {
     EXPECT_NEAR(mean, series(depth), tol) << "maxdepth " << depth;
     if (depth <= 5) {
       EXPECT_GT(std::abs(mean - series(depth + 1)), tol) << "maxdepth " << depth << " vs " << depth + 1;
-      if (depth > 0) EXPECT_GT(std::abs(mean - series(depth - 1)), tol) << "maxdepth " << depth << " vs " << depth - 1;
+      if (depth > 0) {
+        EXPECT_GT(std::abs(mean - series(depth - 1)), tol) << "maxdepth " << depth << " vs " << depth - 1;
+      }
     }
   }
 }

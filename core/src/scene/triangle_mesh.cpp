@@ -1,5 +1,7 @@
 #include "scene/triangle_mesh.h"
 
+#include "util/cpu_clones.h"
+
 #include <penumbra/interaction.h>
 #include <penumbra/sampling.h>
 
@@ -47,7 +49,7 @@ Vec3 TriangleMesh::geometric_normal(size_t i, const Vec3& b) const {
   return oriented(face_normal(i), shading_normal(i, b));
 }
 
-TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
+PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
   const uint32_t* v = &indices[3 * i];
   const Vec3 &p0 = P[v[0]], &p1 = P[v[1]], &p2 = P[v[2]];
   Surface s;

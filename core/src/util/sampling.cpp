@@ -1,5 +1,7 @@
 #include <penumbra/sampling.h>
 
+#include "util/cpu_clones.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -17,26 +19,30 @@ void sincos_quarter_pi(float a, float* s, float* c) {
   *c = 1.f + a2 * (-0.5f + a2 * (1.f / 24.f + a2 * (-1.f / 720.f + a2 * (1.f / 40320.f + a2 * (-1.f / 3628800.f)))));
 }
 
-}  // namespace
-
-Vec2 sample_uniform_disk_concentric(Vec2 u) {
+// The map of sample_uniform_disk_concentric(), shared by the clones below.
+inline Vec2 disk_concentric(Vec2 u) {
   // Shirley-Chiu: concentric squares map to concentric circles, so strata stay compact (unlike the
   // polar map, which squeezes the square's left edge into the centre). The angle is pi/4 times a
   // ratio in [-1, 1], or pi/2 minus that, so sin and cos of a quarter-circle angle suffice.
+  // The two halves of the square (|x| > |y| or not) are chosen by selects, not a branch: the
+  // branch went either way at random and its mispredictions were most of this function's time.
   Vec2 o = 2.f * u - Vec2(1.f);
-  if (o.x == 0.f && o.y == 0.f) return Vec2(0.f);
+  bool x_major = std::abs(o.x) > std::abs(o.y);
+  float r = x_major ? o.x : o.y, other = x_major ? o.y : o.x;
+  if (r == 0.f) return Vec2(0.f);  // the centre: both are 0
   float s, c;
-  if (std::abs(o.x) > std::abs(o.y)) {
-    sincos_quarter_pi((Pi / 4.f) * (o.y / o.x), &s, &c);
-    return o.x * Vec2(c, s);
-  }
-  sincos_quarter_pi((Pi / 4.f) * (o.x / o.y), &s, &c);
-  return o.y * Vec2(s, c);  // cos(pi/2 - a) = sin a, sin(pi/2 - a) = cos a
+  sincos_quarter_pi((Pi / 4.f) * (other / r), &s, &c);
+  // x major: r (cos a, sin a); y major: r (sin a, cos a), since cos(pi/2 - a) = sin a.
+  return r * Vec2(x_major ? c : s, x_major ? s : c);
 }
 
-Vec3 sample_cosine_hemisphere(Vec2 u) {
+}  // namespace
+
+PENUMBRA_X86_64_V3_CLONES Vec2 sample_uniform_disk_concentric(Vec2 u) { return disk_concentric(u); }
+
+PENUMBRA_X86_64_V3_CLONES Vec3 sample_cosine_hemisphere(Vec2 u) {
   // Malley's method: uniform on the disk, projected up onto the hemisphere, is cosine-distributed.
-  Vec2 d = sample_uniform_disk_concentric(u);
+  Vec2 d = disk_concentric(u);
   return Vec3(d.x, d.y, safe_sqrt(1.f - d.x * d.x - d.y * d.y));
 }
 
