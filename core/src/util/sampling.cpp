@@ -24,8 +24,9 @@ inline Vec2 disk_concentric(Vec2 u) {
   // Shirley-Chiu: concentric squares map to concentric circles, so strata stay compact (unlike the
   // polar map, which squeezes the square's left edge into the centre). The angle is pi/4 times a
   // ratio in [-1, 1], or pi/2 minus that, so sin and cos of a quarter-circle angle suffice.
-  // The two halves of the square (|x| > |y| or not) are chosen by selects, not a branch: the
-  // branch went either way at random and its mispredictions were most of this function's time.
+  // The two halves of the square (|x| > |y| or not) are chosen by selects rather than by a branch
+  // that goes either way at random: one blendv each in the x86-64-v3 clone (docs/benchmarks.md,
+  // "FMA clones of the hottest scalar math", has what each part gained).
   Vec2 o = 2.f * u - Vec2(1.f);
   bool x_major = std::abs(o.x) > std::abs(o.y);
   float r = x_major ? o.x : o.y, other = x_major ? o.y : o.x;

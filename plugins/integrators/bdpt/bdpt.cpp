@@ -5,11 +5,12 @@
 //   s = 1       next-event estimation with the light's own sample_li();
 //   t = 1       the light subpath connects to the lens (camera sample_wi) and splats on the film;
 //   s, t >= 2   a shadow ray joins light vertex s-1 and camera vertex t-1.
-// The strategies are combined by MIS (balance heuristic by default, as pbrt-v3 and v4) computed from the path's forward
-// and reverse densities (mis.h, subpath.h: formulation and reasons). Delta lights and specular
-// lobes are never connected to; environment and distant lights are directions whose emitted paths
-// start on a disk covering the scene. Subpaths use Russian roulette after rrdepth bounces (kept out of
-// the MIS densities, see subpath.h); set rrdepth above maxdepth for pbrt-v3's behaviour (none).
+// The strategies are combined by MIS (balance heuristic by default, as in pbrt-v3 and v4) computed
+// from the path's forward and reverse densities (mis.h, subpath.h: formulation and reasons). Delta
+// lights and specular lobes are never connected to; environment and distant lights are directions
+// whose emitted paths start on a disk covering the scene. Subpaths use Russian roulette after rrdepth
+// bounces (kept out of the MIS densities, see subpath.h); set rrdepth above maxdepth for pbrt-v3's
+// behaviour (none).
 //
 // | parameter                | default | meaning                                                |
 // |--------------------------|---------|--------------------------------------------------------|
