@@ -47,3 +47,16 @@ bench_build_arch() {
     echo x86-64
   fi
 }
+
+# Sets $work to the folder where a run keeps its files: KEEP (created) when given, otherwise a new
+# temporary folder named after PREFIX that is removed when the script exits.
+bench_work_dir() {
+  local keep="$1" prefix="$2"
+  if [ -n "$keep" ]; then
+    work="$keep"
+    mkdir -p "$work"
+  else
+    work=$(mktemp -d "${TMPDIR:-/tmp}/$prefix.XXXXXX")
+    trap 'rm -rf "$work"' EXIT
+  fi
+}

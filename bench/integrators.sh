@@ -66,13 +66,7 @@ integrator_list=${integrators//,/ }
 bench_find_build "$build"
 py=$(bench_python)
 
-if [ -n "$keep" ]; then
-  work="$keep"
-  mkdir -p "$work"
-else
-  work=$(mktemp -d "${TMPDIR:-/tmp}/penumbra-bench.XXXXXX")
-  trap 'rm -rf "$work"' EXIT
-fi
+bench_work_dir "$keep" penumbra-bench
 
 date_iso=$(date -Iseconds)
 commit=$(bench_commit "$root")

@@ -69,13 +69,7 @@ for a in ${algorithms//,/ }; do
   [ -n "${integrator[$a]:-}" ] || { echo "vs-smallvcm.sh: --algorithms: unknown '$a' (pt, bpt, ppm)" >&2; exit 2; }
 done
 
-if [ -n "$keep" ]; then
-  work="$keep"
-  mkdir -p "$work"
-else
-  work=$(mktemp -d "${TMPDIR:-/tmp}/penumbra-vs-smallvcm.XXXXXX")
-  trap 'rm -rf "$work"' EXIT
-fi
+bench_work_dir "$keep" penumbra-vs-smallvcm
 csv="$work/renders.csv"
 echo "renderer,scene,algorithm,run,passes,seconds,relmse,load" > "$csv"
 echo "vs-smallvcm.sh: $runs runs x scenes $scenes x $algorithms, ${time_budget} s, $threads threads;" \
