@@ -52,10 +52,10 @@ done
 [ -n "$smallvcm" ] || { echo "vs-smallvcm.sh: --smallvcm BIN is required (see --help)" >&2; exit 2; }
 [ -x "$smallvcm" ] || { echo "vs-smallvcm.sh: --smallvcm: '$smallvcm' is not an executable file" >&2; exit 2; }
 smallvcm=$(cd "$(dirname "$smallvcm")" && pwd)/$(basename "$smallvcm")
-for n in runs time_budget threads pause; do
-  [[ "${!n}" =~ ^[0-9]+$ ]] && [ "${!n}" -gt 0 -o "$n" = pause ] ||
-    { echo "vs-smallvcm.sh: --${n/_budget/} must be a positive integer" >&2; exit 2; }
+for option in runs:"$runs" time:"$time_budget" threads:"$threads"; do
+  [[ "${option#*:}" =~ ^[1-9][0-9]*$ ]] || { echo "vs-smallvcm.sh: --${option%%:*} must be a positive integer" >&2; exit 2; }
 done
+[[ "$pause" =~ ^[0-9]+$ ]] || { echo "vs-smallvcm.sh: --pause must be a whole number of seconds" >&2; exit 2; }
 command -v oiiotool >/dev/null || { echo "vs-smallvcm.sh: needs oiiotool (Debian: openimageio-tools)" >&2; exit 1; }
 bench_find_build "$build"
 py=$(bench_python)

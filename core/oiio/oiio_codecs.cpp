@@ -42,8 +42,8 @@ std::unique_ptr<OIIO::ImageInput> open_checked(const std::string& path) {
   if (!in) throw Error(fmt::format("cannot read image '{}': {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
   constexpr double kMaxPixels = 268435456.0;  // 2^28 pixels: 3 GiB as RGB floats
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.nchannels > kMaxImageChannels || spec.depth > 1 ||
-      static_cast<double>(spec.width) * spec.height > kMaxPixels)
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.nchannels > kMaxImageChannels ||
+      spec.depth > 1 || static_cast<double>(spec.width) * spec.height > kMaxPixels)
     throw Error(fmt::format("cannot read image '{}': {}x{} pixels{} with {} channels is outside what Penumbra reads "
                             "(2D images of at most {:.0f} pixels and {} channels)",
                             path, spec.width, spec.height,

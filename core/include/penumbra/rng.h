@@ -53,10 +53,9 @@ class Pcg32 {
   /// Uniform in [0, 1).
   float next_float() { return std::min(OneMinusEpsilon, next_u32() * 0x1p-32f); }
 
-  /// Skips `delta` outputs: one table step for the low 8 bits, one more per higher set bit.
+  /// Skips `delta` outputs: one step from a table for the low 8 bits of `delta`, then one per higher
+  /// set bit (a sample-index jump, index * 2^16, costs one step per set bit of the index).
   void advance(uint64_t delta) {
-    // The low 8 bits of the jump in one step from kJumps, then each higher set bit k in one step
-    // from kPow2Jumps: a sample-index jump (index * 2^16) costs one step per set bit of the index.
     const Jump& low = kJumps[delta & 255u];
     state_ = low.mult * state_ + low.inc_factor * inc_;
     for (uint64_t high = delta >> 8u; high; high &= high - 1u) {

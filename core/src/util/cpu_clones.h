@@ -6,11 +6,10 @@
 // Only for functions the profile shows, whose polynomial or interpolation chains the compiler fuses
 // into FMAs (docs/benchmarks.md, "FMA clones of the hottest scalar math"). The two versions round
 // differently in the last bit; which one runs depends on the processor, as with -march=native.
-// Set PENUMBRA_NO_CPU_CLONES (a compile definition) to build the baseline alone.
+// Not for clang (the fuzzers) nor for builds that target AVX2 already (PENUMBRA_NATIVE_ARCH).
 #pragma once
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PENUMBRA_NO_CPU_CLONES) && \
-    !defined(__AVX2__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__)
 #define PENUMBRA_X86_64_V3_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define PENUMBRA_X86_64_V3_CLONES
