@@ -1,4 +1,4 @@
-# Helpers shared by bench/integrators.sh and bench/make-references.sh (sourced).
+# Helpers shared by the scripts of bench/ (sourced).
 
 # Short commit hash, "+dirty" when tracked files differ from it (the benchmark's own results and
 # references under bench/results/ and bench/references/ do not count).
@@ -59,4 +59,20 @@ bench_work_dir() {
     work=$(mktemp -d "${TMPDIR:-/tmp}/$prefix.XXXXXX")
     trap 'rm -rf "$work"' EXIT
   fi
+}
+
+# The set-up every per-(scene, integrator) benchmark script makes once its options are read: sets
+# scene_list and integrator_list (one a word) from the comma-separated SCENES and INTEGRATORS, checks
+# BUILD, and sets py, work (bench_work_dir KEEP PREFIX), date_iso, commit (of $root), cpu and arch.
+bench_prepare() {
+  local scenes="$1" integrators="$2" build="$3" keep="$4" prefix="$5"
+  scene_list=$(bench_check_scenes "$scenes") || exit 1
+  integrator_list=${integrators//,/ }
+  bench_find_build "$build"
+  py=$(bench_python)
+  bench_work_dir "$keep" "$prefix"
+  date_iso=$(date -Iseconds)
+  commit=$(bench_commit "$root")
+  cpu=$(bench_cpu_model)
+  arch=$(bench_build_arch "$build")
 }

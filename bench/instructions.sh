@@ -52,16 +52,7 @@ done
 [[ "$res" =~ ^[1-9][0-9]*$ ]] && [ "$res" -gt 8 ] || { echo "instructions.sh: --res must be an integer above 8" >&2; exit 2; }
 [[ "$passes" =~ ^[1-9][0-9]*$ ]] || { echo "instructions.sh: --passes must be a positive integer" >&2; exit 2; }
 command -v valgrind > /dev/null || { echo "instructions.sh: needs valgrind (apt-get install valgrind)" >&2; exit 1; }
-scene_list=$(bench_check_scenes "$scenes")
-integrator_list=${integrators//,/ }
-bench_find_build "$build"
-py=$(bench_python)
-bench_work_dir "$keep" penumbra-instructions
-
-date_iso=$(date -Iseconds)
-commit=$(bench_commit "$root")
-cpu=$(bench_cpu_model)
-arch=$(bench_build_arch "$build")
+bench_prepare "$scenes" "$integrators" "$build" "$keep" penumbra-instructions
 vg=$(valgrind --version)
 echo "instructions.sh: $(echo $scene_list | wc -w) scenes x $(echo $integrator_list | wc -w) integrators," \
   "${res}x${res} x $passes passes minus 8x8 x 1; commit $commit ($arch build), $vg" >&2

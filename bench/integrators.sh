@@ -61,18 +61,8 @@ if [ "$quick" = 1 ]; then
   history=0
 fi
 [[ "$runs" =~ ^[1-9][0-9]*$ ]] || { echo "integrators.sh: --runs must be a positive integer" >&2; exit 2; }
-scene_list=$(bench_check_scenes "$scenes")
-integrator_list=${integrators//,/ }
-bench_find_build "$build"
-py=$(bench_python)
-
-bench_work_dir "$keep" penumbra-bench
-
-date_iso=$(date -Iseconds)
-commit=$(bench_commit "$root")
-cpu=$(bench_cpu_model)
+bench_prepare "$scenes" "$integrators" "$build" "$keep" penumbra-bench
 load=$(bench_loadavg)
-arch=$(bench_build_arch "$build")
 echo "integrators.sh: $(echo $scene_list | wc -w) scenes x $(echo $integrator_list | wc -w) integrators x $runs runs" \
   "x ${time_budget} s, $threads threads; commit $commit ($arch build); load average $load on $(nproc) cores" >&2
 
