@@ -3,7 +3,8 @@
 # counted by valgrind's callgrind. Wall-clock figures on a shared machine move by 5-50 % from run to
 # run (docs/benchmarks.md); instruction counts of a one-thread render with a fixed seed do not (two
 # runs differ by less than 0.02 %), so a change of a percent in what the renderer does per ray shows,
-# and a regression shows as a step in bench/results/instructions.csv. They do not see cache misses
+# and a regression shows as a step in bench/results/instructions.csv (plot it with
+# bench/plot-history.py --csv bench/results/instructions.csv). They do not see cache misses
 # or stalls: a change that moves memory traffic needs alternated wall-clock pairs.
 #
 # For each (scene, integrator) two one-thread renders with seed 1 are counted whole: RES x RES with
