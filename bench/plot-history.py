@@ -8,7 +8,8 @@ otherwise, since passes/s is only comparable between like runs.
 
 With --csv bench/results/instructions.csv (written by bench/instructions.sh) it plots instructions
 per ray (or --metric instructions_per_sample) instead, keeping the runs with the most common image
-size, pass count, machine, build architecture and valgrind version.
+size, pass count, machine, build architecture and valgrind version (--time and --threads do not
+apply there).
 
 Usage: bench/plot-history.py [--csv bench/results/history.csv] [-o FILE.png (default: the CSV's name)]
                              [--metric passes_per_s|mrays_per_s|relmse|ratio_to_embree|
