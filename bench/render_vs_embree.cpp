@@ -39,6 +39,18 @@ double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// A closest-hit query from o along d over (0, infinity), as Embree takes it.
+RTCRayHit closest_hit_query(const Vec3& o, const Vec3& d) {
+  RTCRayHit rh;
+  std::memset(&rh, 0, sizeof rh);
+  rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
+  rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+  rh.ray.tfar = Infinity;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
 struct RawResult {
   double closest_mrays, shadow_mrays, mixed_mrays;
 };
@@ -50,14 +62,7 @@ RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
   for (size_t i = 0; i < n; ++i) {
     Pcg32 rng(i, 7);
     Vec3 o = b.min + (b.max - b.min) * Vec3(rng.next_float(), rng.next_float(), rng.next_float());
-    Vec3 d = sample_uniform_sphere(Vec2(rng.next_float(), rng.next_float()));
-    RTCRayHit& rh = rays[i];
-    std::memset(&rh, 0, sizeof rh);
-    rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
-    rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
-    rh.ray.tfar = Infinity;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rays[i] = closest_hit_query(o, sample_uniform_sphere(Vec2(rng.next_float(), rng.next_float())));
   }
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   std::vector<RTCRayHit> work = rays;
@@ -101,7 +106,8 @@ RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
 // 8-wide packets of 4x2 pixels (rtcIntersect8, coherent): what packet tracing of camera rays would
 // gain, which the renderer does not do (docs/benchmarks.md, "Camera rays as packets"). Both return
 // the same hits except along edges between primitives, where the two intersectors round differently
-// (counted; more than 0.1 % of the pixels is an error). Mrays/s on `threads` threads.
+// (counted; more than 0.1 % of the pixels is an error). Mrays/s on `threads` threads; both ways fill
+// their query structures inside the timing, as a renderer would for each ray.
 struct CameraRays {
   double single_mrays, packet_mrays;
   size_t differ;  // pixels whose two rays hit different geometry
@@ -126,13 +132,7 @@ CameraRays camera_rays(RTCScene scene, const Camera& camera, Point2i res, int th
       for (int y = r.begin(); y < r.end(); ++y)
         for (int x = 0; x < w; ++x) {
           size_t i = static_cast<size_t>(y) * w + x;
-          RTCRayHit rh;
-          std::memset(&rh, 0, sizeof rh);
-          rh.ray.org_x = rays[i].o.x, rh.ray.org_y = rays[i].o.y, rh.ray.org_z = rays[i].o.z;
-          rh.ray.dir_x = rays[i].d.x, rh.ray.dir_y = rays[i].d.y, rh.ray.dir_z = rays[i].d.z;
-          rh.ray.tfar = Infinity;
-          rh.ray.mask = 0xFFFFFFFFu;
-          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          RTCRayHit rh = closest_hit_query(rays[i].o, rays[i].d);
           rtcIntersect1(scene, &ctx, &rh);
           single_hit[i] = rh.hit.geomID;
         }
