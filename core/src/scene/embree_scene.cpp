@@ -208,7 +208,10 @@ void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const
     const_cast<Light*>(lights_[i])->set_index(static_cast<uint32_t>(i));
     power.push_back(std::max(0.f, luminance(lights_[i]->power())));
   }
-  if (!lights_.empty()) light_distribution_ = Distribution1D(power);
+  if (lights_.empty()) return;
+  light_distribution_ = Distribution1D(power);
+  light_pmfs_.resize(lights_.size());
+  for (size_t i = 0; i < lights_.size(); ++i) light_pmfs_[i] = light_distribution_.discrete_pmf(i);
 }
 
 void EmbreeScene::commit() { rtcCommitScene(scene_); }
@@ -269,15 +272,16 @@ size_t EmbreeScene::triangle_count() const {
 std::optional<SampledLight> EmbreeScene::sample_light(float u) const {
   if (lights_.empty()) return std::nullopt;
   if (lights_.size() == 1) return SampledLight{lights_[0], 1.f};  // what the distribution gives, without the search
-  float pmf = 0.f;
-  size_t i = light_distribution_.sample_discrete(u, &pmf);
+  size_t i = light_distribution_.sample_discrete(u);
+  float pmf = light_pmfs_[i];
   if (pmf == 0.f) return std::nullopt;
   return SampledLight{lights_[i], pmf};
 }
 
 float EmbreeScene::light_pmf(const Light* light) const {
   if (lights_.empty() || !light) return 0.f;
-  return light_distribution_.discrete_pmf(light->index());
+  size_t i = light->index();
+  return i < light_pmfs_.size() ? light_pmfs_[i] : 0.f;  // discrete_pmf()'s answer out of range
 }
 
 static RTCRayHit make_rayhit(const Ray& ray) {

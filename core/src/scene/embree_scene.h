@@ -146,6 +146,7 @@ class EmbreeScene final : public Scene {
   std::vector<std::unique_ptr<GeometryUserData>> user_data_;  // Embree callbacks' (quadrics, cut-outs)
   std::vector<const Light*> lights_, infinite_;
   Distribution1D light_distribution_;  // over lights_, proportional to luminance of power
+  std::vector<float> light_pmfs_;      // its discrete_pmf() of each light, looked up per light sample
   std::unique_ptr<Camera> camera_;
   Bounds3 bounds_;
   float footprint_scale_ = 1.f;

@@ -108,10 +108,10 @@ ShapeSample Triangle::sample_area(Vec2 u) const {
 void Triangle::area_sample_into(Vec2 u, ShapeSample& s) const {
   Vec2 b12 = sample_uniform_triangle(u);
   Vec3 b(1.f - b12.x - b12.y, b12.x, b12.y);
-  s.p = mesh_->position(index_, b);
-  s.n = mesh_->geometric_normal(index_, b);
-  s.uv = mesh_->uv_at(index_, b);
-  s.pdf = 1.f / area();
+  s.p = b.x * p_[0] + b.y * p_[1] + b.z * p_[2];
+  s.n = n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, b);
+  s.uv = b.x * uv_[0] + b.y * uv_[1] + b.z * uv_[2];
+  s.pdf = inv_area_;
 }
 
 namespace {
@@ -158,8 +158,14 @@ std::optional<Vec3> sample_spherical_triangle(const Vec3& a, const Vec3& b, cons
 
 Triangle::Triangle(const TriangleMesh* mesh, uint32_t index) : mesh_(mesh), index_(index) {
   const uint32_t* v = &mesh->indices[3 * index];
-  centroid_ = (mesh->P[v[0]] + mesh->P[v[1]] + mesh->P[v[2]]) / 3.f;
+  for (int k = 0; k < 3; ++k) {
+    p_[k] = mesh->P[v[k]];
+    uv_[k] = mesh->uv.empty() ? Vec2(k == 0 ? 0.f : 1.f, k == 2 ? 1.f : 0.f) : mesh->uv[v[k]];
+  }
+  if (mesh->N.empty()) n_flat_ = mesh->geometric_normal(index, Vec3(1.f / 3.f));  // the same for every b
+  centroid_ = (p_[0] + p_[1] + p_[2]) / 3.f;
   area_ = mesh->area(index);
+  inv_area_ = 1.f / area_;
 }
 
 // Spherical sampling pays for its trigonometry only where the triangle is near and large: area over
@@ -177,8 +183,7 @@ bool Triangle::spherical_worthwhile(const Vec3& p) const {
 // pdf_solid_angle() makes the same choice.
 std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const {
   if (!spherical_worthwhile(ctx.p)) return sample_by_area(ctx, u);
-  const uint32_t* v = &mesh_->indices[3 * index_];
-  Vec3 p0 = mesh_->P[v[0]], p1 = mesh_->P[v[1]], p2 = mesh_->P[v[2]];
+  const Vec3 &p0 = p_[0], &p1 = p_[1], &p2 = p_[2];
   Vec3 a = glm::normalize(p0 - ctx.p), b = glm::normalize(p1 - ctx.p), c = glm::normalize(p2 - ctx.p);
   float omega = solid_angle(a, b, c);
   if (omega >= kMinSphericalSolidAngle && omega <= kMaxSphericalSolidAngle) {
@@ -196,8 +201,9 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
       b1 /= sum, b2 /= sum;
     }
     Vec3 bary(1.f - b1 - b2, b1, b2);
-    return ShapeSample{mesh_->position(index_, bary), mesh_->geometric_normal(index_, bary), mesh_->uv_at(index_, bary),
-                       1.f / omega};
+    return ShapeSample{bary.x * p0 + bary.y * p1 + bary.z * p2,
+                       n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, bary),
+                       bary.x * uv_[0] + bary.y * uv_[1] + bary.z * uv_[2], 1.f / omega};
   }
   return sample_by_area(ctx, u);
 }
@@ -214,15 +220,13 @@ std::optional<ShapeSample> Triangle::sample_by_area(const ShapeSampleContext& ct
 float Triangle::pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
                                 const Vec3& n_hit) const {
   if (!spherical_worthwhile(ctx.p)) {
-    float pdf = area_to_solid_angle_pdf(1.f / area(), ctx.p, p_hit, n_hit);
+    float pdf = area_to_solid_angle_pdf(inv_area_, ctx.p, p_hit, n_hit);
     return std::isinf(pdf) ? 0.f : pdf;
   }
-  const uint32_t* v = &mesh_->indices[3 * index_];
-  Vec3 a = glm::normalize(mesh_->P[v[0]] - ctx.p), b = glm::normalize(mesh_->P[v[1]] - ctx.p),
-       c = glm::normalize(mesh_->P[v[2]] - ctx.p);
+  Vec3 a = glm::normalize(p_[0] - ctx.p), b = glm::normalize(p_[1] - ctx.p), c = glm::normalize(p_[2] - ctx.p);
   float omega = solid_angle(a, b, c);
   if (omega >= kMinSphericalSolidAngle && omega <= kMaxSphericalSolidAngle) return 1.f / omega;
-  float pdf = area_to_solid_angle_pdf(1.f / area(), ctx.p, p_hit, n_hit);
+  float pdf = area_to_solid_angle_pdf(inv_area_, ctx.p, p_hit, n_hit);
   return std::isinf(pdf) ? 0.f : pdf;
 }
 

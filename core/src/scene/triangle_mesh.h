@@ -59,8 +59,13 @@ class Triangle final : public Shape {
   void area_sample_into(Vec2 u, ShapeSample& s) const;
   const TriangleMesh* mesh_;
   uint32_t index_;
+  // Copies of what every light sample reads, so that sampling does not go through the mesh's index
+  // and vertex arrays (the same values, so the same samples as reading the mesh).
+  Vec3 p_[3];
+  Vec2 uv_[3];         // the mesh's, or pbrt's default (0,0), (1,0), (1,1)
+  Vec3 n_flat_{0.f};   // the oriented face normal, for a mesh without shading normals (else zero)
   Vec3 centroid_;
-  float area_;
+  float area_, inv_area_;
 };
 
 }  // namespace penumbra
