@@ -61,8 +61,15 @@ PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, 
     float len2 = glm::dot(n, n);
     if (len2 > 0.f) ns = n / std::sqrt(len2);
   }
-  s.ng = oriented(face_normal(i), ns);
-  s.ns = ns == Vec3(0.f) ? s.ng : ns;
+  // face_normal() and oriented() written out: this x86-64-v3 clone called both out of line
+  // (39 instructions per hit on the Cornell box).
+  Vec3 fn = i < face_normals.size() ? face_normals[i] : face_normal(i);
+  if (ns == Vec3(0.f)) {
+    s.ng = s.ns = flip_normal ? -fn : fn;
+  } else {
+    s.ng = glm::dot(fn, ns) < 0.f ? -fn : fn;
+    s.ns = ns;
+  }
   s.uv = uv.empty() ? Vec2(b.y + b.z, b.z) : b.x * uv[v[0]] + b.y * uv[v[1]] + b.z * uv[v[2]];
   return s;
 }
