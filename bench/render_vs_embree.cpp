@@ -1,8 +1,11 @@
 // Measures, in one run on the same geometry, (1) the path tracer's whole-render ray throughput on the
 // Cornell box and (2) Embree's raw throughput for incoherent closest-hit and shadow rays with no
 // shading, and prints their ratio.
-// Usage: penumbra-bench-render [--scene FILE] [--threads N] [--spp N] [--res N] [--rays N] [--raw-only]
-//                              [--camera-packets] [--json]
+// Usage: penumbra-bench-render [--scene FILE] [--threads N] [--spp N] [--res N] [--rays N] [--rounds N]
+//                              [--raw-only] [--camera-packets] [--json]
+//   --rounds N        the render and the raw measurement alternate N times per thread count (default 5);
+//                     each round gives a ratio, and the median ratio and the range are reported, so a
+//                     drift of the machine between the two measurements moves one round, not the figure
 //   --raw-only        skips the path-tracer render: only raw Embree on the scene's geometry (any scene file)
 //   --camera-packets  only the scene's camera rays at its film resolution (about --rays of them), one
 //                     at a time and as 8-wide packets
@@ -37,6 +40,13 @@ namespace {
 
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Median of a non-empty list (the mean of the two middle values for an even count).
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // A closest-hit query from o along d over (0, infinity), as Embree takes it.
@@ -177,7 +187,7 @@ CameraRays camera_rays(RTCScene scene, const Camera& camera, Point2i res, int th
 }  // namespace
 
 int main(int argc, char** argv) {
-  int spp = 32, res = 256;
+  int spp = 32, res = 256, rounds = 5;
   size_t n_rays = 2'000'000;
   bool raw_only = false, json = false, camera_packets = false;
   std::string scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
@@ -190,11 +200,22 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "penumbra-bench-render: {} needs a value\n", argv[i]);
       return 2;
     }
-    if (!std::strcmp(argv[i], "--spp")) spp = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--res")) res = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--threads")) thread_counts = {std::atoi(argv[i + 1])};
+    // Counts must be whole positive numbers; anything else is refused, naming the option.
+    auto count = [&](const char* option) -> long long {
+      char* end = nullptr;
+      long long v = std::strtoll(argv[i + 1], &end, 10);
+      if (end == argv[i + 1] || *end != '\0' || v <= 0 || v > 1'000'000'000'000LL) {
+        fmt::print(stderr, "penumbra-bench-render: {} needs a positive whole number, got '{}'\n", option, argv[i + 1]);
+        std::exit(2);
+      }
+      return v;
+    };
+    if (!std::strcmp(argv[i], "--spp")) spp = static_cast<int>(std::min(count("--spp"), 1LL << 30));
+    else if (!std::strcmp(argv[i], "--res")) res = static_cast<int>(std::min(count("--res"), 1LL << 16));
+    else if (!std::strcmp(argv[i], "--threads")) thread_counts = {static_cast<int>(std::min(count("--threads"), 4096LL))};
     else if (!std::strcmp(argv[i], "--scene")) scene_file = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--rays")) n_rays = std::strtoull(argv[i + 1], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--rays")) n_rays = static_cast<size_t>(count("--rays"));
+    else if (!std::strcmp(argv[i], "--rounds")) rounds = static_cast<int>(std::min(count("--rounds"), 1000LL));
     else {
       fmt::print(stderr, "penumbra-bench-render: unknown option {}\n", argv[i]);
       return 2;
@@ -217,13 +238,13 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    if (raw_only || json) {
-      for (int threads : thread_counts) {
-        nlohmann::json j;
-        j["scene"] = scene_file;
-        j["triangles"] = built.scene->triangle_count();
-        j["threads"] = threads;
-        j["rays"] = n_rays;
+    // Rounds of (path render, raw Embree) on each thread count; rates and ratios are medians over rounds.
+    struct Rounds {
+      std::vector<double> path_mrays, path_msamples, closest, shadow, mixed, ratio;
+    };
+    auto measure = [&](int threads) {
+      Rounds r;
+      for (int round = 0; round < rounds; ++round) {
         if (!raw_only) {
           RenderSettings settings;
           settings.scene_file = scene_file;
@@ -232,38 +253,57 @@ int main(int argc, char** argv) {
           settings.threads = threads;
           settings.quiet = true;
           RenderStats s = render(settings).stats;
-          j["path_mrays_per_second"] = s.mrays_per_second();
-          j["path_msamples_per_second"] = s.pixels * double(s.spp) / s.seconds * 1e-6;
+          r.path_mrays.push_back(s.mrays_per_second());
+          r.path_msamples.push_back(s.pixels * double(s.spp) / s.seconds * 1e-6);
         }
         RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
-        j["raw_closest_mrays_per_second"] = raw.closest_mrays;
-        j["raw_shadow_mrays_per_second"] = raw.shadow_mrays;
-        j["raw_mixed_mrays_per_second"] = raw.mixed_mrays;
+        r.closest.push_back(raw.closest_mrays);
+        r.shadow.push_back(raw.shadow_mrays);
+        r.mixed.push_back(raw.mixed_mrays);
+        if (!raw_only) r.ratio.push_back(r.path_mrays.back() / raw.mixed_mrays);
+      }
+      return r;
+    };
+    if (raw_only || json) {
+      for (int threads : thread_counts) {
+        Rounds r = measure(threads);
+        nlohmann::json j;
+        j["scene"] = scene_file;
+        j["triangles"] = built.scene->triangle_count();
+        j["threads"] = threads;
+        j["rays"] = n_rays;
+        j["rounds"] = rounds;
+        if (!raw_only) {
+          j["path_mrays_per_second"] = median(r.path_mrays);
+          j["path_msamples_per_second"] = median(r.path_msamples);
+          j["ratio"] = median(r.ratio);
+          j["ratio_min"] = *std::min_element(r.ratio.begin(), r.ratio.end());
+          j["ratio_max"] = *std::max_element(r.ratio.begin(), r.ratio.end());
+        }
+        j["raw_closest_mrays_per_second"] = median(r.closest);
+        j["raw_shadow_mrays_per_second"] = median(r.shadow);
+        j["raw_mixed_mrays_per_second"] = median(r.mixed);
         if (json) fmt::print("{}\n", j.dump());
         else
-          fmt::print("scene {}: {} triangles, {} threads: raw Embree closest-hit {:.2f}, shadow {:.2f}, mixed {:.2f} Mrays/s\n",
-                     scene_file, built.scene->triangle_count(), threads, raw.closest_mrays, raw.shadow_mrays,
-                     raw.mixed_mrays);
+          fmt::print("scene {}: {} triangles, {} threads: raw Embree closest-hit {:.2f}, shadow {:.2f}, mixed {:.2f} Mrays/s "
+                     "(medians of {} rounds)\n",
+                     scene_file, built.scene->triangle_count(), threads, median(r.closest), median(r.shadow),
+                     median(r.mixed), rounds);
       }
       return 0;
     }
-    fmt::print("scene {}: {} triangles\n", scene_file, built.scene->triangle_count());
-    fmt::print("{:>7} {:>14} {:>14} {:>14} {:>14} {:>12} {:>8}\n", "threads", "path Mrays/s", "Msamples/s",
-               "raw hit Mr/s", "raw shad Mr/s", "raw mix Mr/s", "ratio");
+    fmt::print("scene {}: {} triangles; medians of {} alternated rounds (render, raw Embree); the ratio is the median "
+               "of the rounds' ratios [min, max]\n",
+               scene_file, built.scene->triangle_count(), rounds);
+    fmt::print("{:>7} {:>14} {:>14} {:>14} {:>14} {:>12} {:>8} {:>16}\n", "threads", "path Mrays/s", "Msamples/s",
+               "raw hit Mr/s", "raw shad Mr/s", "raw mix Mr/s", "ratio", "[min, max]");
     for (int threads : thread_counts) {
-      RenderSettings settings;
-      settings.scene_file = scene_file;
-      settings.spp = spp;
-      settings.resolution = std::make_pair(res, res);
-      settings.threads = threads;
-      settings.quiet = true;
-      RenderResult r = render(settings);
-      const RenderStats& s = r.stats;
-      double msamples = s.pixels * double(s.spp) / s.seconds * 1e-6;
-      RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
-      fmt::print("{:>7} {:>14.2f} {:>14.3f} {:>14.2f} {:>14.2f} {:>12.2f} {:>7.1f}%\n", threads,
-                 s.mrays_per_second(), msamples, raw.closest_mrays, raw.shadow_mrays, raw.mixed_mrays,
-                 100.0 * s.mrays_per_second() / raw.mixed_mrays);
+      Rounds r = measure(threads);
+      fmt::print("{:>7} {:>14.2f} {:>14.3f} {:>14.2f} {:>14.2f} {:>12.2f} {:>7.1f}% {:>16}\n", threads,
+                 median(r.path_mrays), median(r.path_msamples), median(r.closest), median(r.shadow), median(r.mixed),
+                 100.0 * median(r.ratio),
+                 fmt::format("[{:.1f}, {:.1f}]", 100.0 * *std::min_element(r.ratio.begin(), r.ratio.end()),
+                             100.0 * *std::max_element(r.ratio.begin(), r.ratio.end())));
     }
   } catch (const Error& e) {
     fmt::print(stderr, "{}\n", e.formatted());
