@@ -98,6 +98,11 @@ Distribution1D::Distribution1D(std::span<const float> f) : func_(f.size()), cdf_
 // next bin then also satisfies the condition.
 static size_t find_interval(const std::vector<float>& cdf, float u) {
   size_t n = cdf.size() - 1;
+  if (n <= 8) {  // a few bins (a scene's lights): a scan with upper_bound's test, without its set-up
+    size_t i = 0;
+    while (i + 1 < n && !(u < cdf[i + 1])) ++i;
+    return i;
+  }
   auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
   size_t i = it == cdf.begin() ? 0 : size_t(it - cdf.begin()) - 1;
   return std::min(i, n - 1);
