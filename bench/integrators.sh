@@ -7,7 +7,9 @@
 #   relMSE     mean over pixels and channels of (I - R)^2 / (R^2 + 0.01) against the stored reference
 #              bench/references/<scene>.exr (bench/make-references.sh); median [min, max] over --runs
 #   vs Embree  path tracer's Mrays/s over raw Embree's on the same scene and thread count
-#              (penumbra-bench-render --raw-only: incoherent closest-hit and shadow rays, no shading)
+#              (penumbra-bench-render --raw-only: incoherent closest-hit and shadow rays, no shading),
+#              measured just before and just after the path tracer's runs and averaged, so that a
+#              drift of the machine during the renders moves both sides of the ratio alike
 # and appends one line per (scene, integrator) to bench/results/history.csv (plot it with
 # bench/plot-history.py).
 #
@@ -69,12 +71,13 @@ echo "integrators.sh: $(echo $scene_list | wc -w) scenes x $(echo $integrator_li
 for s in $scene_list; do
   file="$root/$(bench_scene_file "$s")"
   mkdir -p "$work/$s"
-  if [[ " $integrator_list " == *" path "* ]]; then
+  raw_embree() {  # raw Embree's rates on this scene into $work/$s/$1
     echo "integrators.sh: $s: raw Embree ($rays rays)" >&2
     "$build/bin/penumbra-bench-render" --scene "$file" --raw-only --json --threads "$threads" --rays "$rays" \
-      > "$work/$s/embree.json"
-  fi
+      > "$work/$s/$1"
+  }
   for i in $integrator_list; do
+    if [ "$i" = path ]; then raw_embree embree.json; fi
     for ((k = 1; k <= runs; ++k)); do
       extra=$(bench_integrator_params "$i")
       # sppm draws its photons from streams of its own seed; the sampler's seed drives only the camera.
@@ -90,6 +93,7 @@ for s in $scene_list; do
           echo '{"relmse": null, "error": "penumbra-bench-image-errors failed"}' > "$work/$s/$i-$k.errors.json"
       fi
     done
+    if [ "$i" = path ]; then raw_embree embree-after.json; fi
   done
 done
 

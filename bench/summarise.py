@@ -56,7 +56,10 @@ def main():
 
     rows, notes = [], []
     for scene in a.scenes.split():
-        embree = load(os.path.join(a.work, scene, "embree.json"))
+        # Raw Embree just before and just after the path tracer's runs: their mean, so that a drift of
+        # the machine during the renders moves both sides of the ratio alike (one of them if only one).
+        raw = [r for r in (load(os.path.join(a.work, scene, f)) for f in ("embree.json", "embree-after.json")) if r]
+        embree_mix = statistics.mean(r["raw_mixed_mrays_per_second"] for r in raw) if raw else None
         ref_meta = load(os.path.join(a.references, scene + ".json"))
         if ref_meta is None and not os.path.exists(os.path.join(a.references, scene + ".exr")):
             notes.append(f"{scene}: no reference (bench/make-references.sh --scenes {scene}); relMSE n/a")
@@ -85,7 +88,6 @@ def main():
             nonfinite = sum(s["nonfinite_samples"] for s in stats) + sum(e.get("nonfinite", 0) for e in errs if e)
             rel = [e["relmse"] for e in errs if e and e.get("relmse") is not None]
             rel_med = statistics.median(rel) if rel else None
-            embree_mix = embree["raw_mixed_mrays_per_second"] if embree else None
             ratio = mrays / embree_mix if (integ == "path" and embree_mix) else None
             rows.append(dict(
                 date=a.date, commit=a.commit, nproc=a.nproc, cpu=a.cpu, loadavg=a.load, threads=a.threads,
