@@ -34,6 +34,8 @@ PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_
   if (!(focal_distance_ > 0.f))
     throw Error(params.loc_of("focaldistance"), "focaldistance must be > 0");
   from_world_ = glm::inverse(to_world_);
+  lens_centre_ = Vec3(to_world_ * Vec4(Vec3(0.f), 1.f));
+  lens_centre_camera_ = Vec3(from_world_ * Vec4(lens_centre_, 1.f));
   // generate_ray() maps the raster rectangle linearly onto the screen window scaled by tan(fov/2)
   // on the z = 1 plane, so that rectangle is the film every importance density refers to.
   Vec2 extent = (screen_max_ - screen_min_) * tan_half_fov_;
@@ -87,7 +89,7 @@ std::optional<Ray> PerspectiveCamera::generate_ray(const CameraSample& s) const 
     dir = focus - origin;
   }
   std::optional<Ray> ray(std::in_place);  // filled where the caller receives it (no copy out)
-  ray->o = Vec3(to_world_ * Vec4(origin, 1.f));
+  ray->o = lens_radius_ > 0.f ? Vec3(to_world_ * Vec4(origin, 1.f)) : lens_centre_;
   ray->d = glm::normalize(Vec3(to_world_ * Vec4(dir, 0.f)));
   ray->tmax = Infinity;
   return ray;
@@ -109,8 +111,14 @@ bool PerspectiveCamera::raster_of(const Vec3& o, const Vec3& d, Vec2* p_raster, 
   return r.x >= -margin_.x && r.y >= -margin_.y && r.x < resolution_.x + margin_.x && r.y < resolution_.y + margin_.y;
 }
 
+// Rays from the lens centre (a pinhole's, and bidirectional methods' t = 1 connections) skip one
+// matrix product: its camera-space position is kept.
+Vec3 PerspectiveCamera::to_camera_point(const Vec3& p) const {
+  return p == lens_centre_ ? lens_centre_camera_ : Vec3(from_world_ * Vec4(p, 1.f));
+}
+
 Rgb PerspectiveCamera::We(const Ray& ray, Vec2* p_raster) const {
-  Vec3 o = Vec3(from_world_ * Vec4(ray.o, 1.f));
+  Vec3 o = to_camera_point(ray.o);
   Vec3 d = glm::normalize(Vec3(from_world_ * Vec4(ray.d, 0.f)));
   float cos_theta;
   if (!raster_of(o, d, p_raster, &cos_theta)) return Rgb(0.f);
@@ -121,7 +129,7 @@ Rgb PerspectiveCamera::We(const Ray& ray, Vec2* p_raster) const {
 }
 
 void PerspectiveCamera::pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) const {
-  Vec3 o = Vec3(from_world_ * Vec4(ray.o, 1.f));
+  Vec3 o = to_camera_point(ray.o);
   Vec3 d = glm::normalize(Vec3(from_world_ * Vec4(ray.d, 0.f)));
   float cos_theta;
   if (!raster_of(o, d, nullptr, &cos_theta)) {
@@ -137,7 +145,7 @@ std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Ve
   if (lens_radius_ > 0.f) lens = Vec3(lens_radius_ * sample_uniform_disk_concentric(u), 0.f);
   // The one object every path returns, filled where the caller receives it (no copy out).
   std::optional<CameraWiSample> out;
-  Vec3 p_lens = Vec3(to_world_ * Vec4(lens, 1.f));
+  Vec3 p_lens = lens_radius_ > 0.f ? Vec3(to_world_ * Vec4(lens, 1.f)) : lens_centre_;
   Vec3 d = p_lens - p_ref;
   float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.f)) return out;

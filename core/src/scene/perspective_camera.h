@@ -31,8 +31,13 @@ class PerspectiveCamera final : public Camera {
   /// Raster position of the camera-space ray (o, unit d), through the plane in focus; false when it
   /// misses the film and its filter margin. `cos_theta` receives d.z.
   bool raster_of(const Vec3& o, const Vec3& d, Vec2* p_raster, float* cos_theta) const;
+  /// A world-space point in camera space.
+  Vec3 to_camera_point(const Vec3& p) const;
 
   Mat4 to_world_, from_world_;
+  // The lens centre (a pinhole's every ray origin) in world space, and taken back to camera space,
+  // each computed once by the expression the per-ray code would use, so the values are the same.
+  Vec3 lens_centre_{0.f}, lens_centre_camera_{0.f};
   Point2i resolution_;
   Vec2 screen_min_, screen_max_;
   float tan_half_fov_;

@@ -376,7 +376,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
       return out.bsdfs[it->second].get();
     }
     if (!default_bsdf) {
-      CreateContext ctx{default_params};
+      CreateContext ctx{default_params, s.loc, {}};
       ctx.spectral = out.spectral;
       out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, kDefaultMaterial, default_params, ctx, s.loc));
       default_bsdf = out.bsdfs.back().get();
@@ -390,7 +390,7 @@ BuiltScene build_scene(SceneDescription& desc, Registry& registry) {
     p.add(Param{"rgb", "color", loc, {m.base_color.r, m.base_color.g, m.base_color.b}, {}, {}});
     p.add(Param{"float", "metallic", loc, {m.metallic}, {}, {}});
     p.add(Param{"float", "roughness", loc, {m.roughness}, {}, {}});
-    CreateContext ctx{p};
+    CreateContext ctx{p, loc, {}};
     ctx.spectral = out.spectral;
     out.bsdfs.push_back(registry.create<Bsdf>(PluginKind::Bsdf, "disney", p, ctx, loc));
     return out.bsdfs.back().get();
