@@ -68,16 +68,18 @@ load=$(bench_loadavg)
 echo "integrators.sh: $(echo $scene_list | wc -w) scenes x $(echo $integrator_list | wc -w) integrators x $runs runs" \
   "x ${time_budget} s, $threads threads; commit $commit ($arch build); load average $load on $(nproc) cores" >&2
 
+# raw_embree SCENE OUTPUT: raw Embree's rates on the scene into $work/SCENE/OUTPUT.
+raw_embree() {
+  echo "integrators.sh: $1: raw Embree ($rays rays)" >&2
+  "$build/bin/penumbra-bench-render" --scene "$root/$(bench_scene_file "$1")" --raw-only --json \
+    --threads "$threads" --rays "$rays" > "$work/$1/$2"
+}
+
 for s in $scene_list; do
   file="$root/$(bench_scene_file "$s")"
   mkdir -p "$work/$s"
-  raw_embree() {  # raw Embree's rates on this scene into $work/$s/$1
-    echo "integrators.sh: $s: raw Embree ($rays rays)" >&2
-    "$build/bin/penumbra-bench-render" --scene "$file" --raw-only --json --threads "$threads" --rays "$rays" \
-      > "$work/$s/$1"
-  }
   for i in $integrator_list; do
-    if [ "$i" = path ]; then raw_embree embree.json; fi
+    if [ "$i" = path ]; then raw_embree "$s" embree.json; fi
     for ((k = 1; k <= runs; ++k)); do
       extra=$(bench_integrator_params "$i")
       # sppm draws its photons from streams of its own seed; the sampler's seed drives only the camera.
@@ -93,7 +95,7 @@ for s in $scene_list; do
           echo '{"relmse": null, "error": "penumbra-bench-image-errors failed"}' > "$work/$s/$i-$k.errors.json"
       fi
     done
-    if [ "$i" = path ]; then raw_embree embree-after.json; fi
+    if [ "$i" = path ]; then raw_embree "$s" embree-after.json; fi
   done
 done
 

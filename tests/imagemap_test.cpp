@@ -238,7 +238,9 @@ TEST_F(Imagemap, PyramidsAreBuiltOncePerFileAndSettings) {
   Textures again(texture("d", grid_, "") + texture("e", grid_, R"("string wrap" "clamp")"));
   EXPECT_EQ(built(again.f("d")), count0 + 2);
   for (auto& [k, v] : t.f("a").statistics())
-    if (k == "mipmap_levels") EXPECT_EQ(v, 3.0);  // 4x4, 2x2, 1x1
+    if (k == "mipmap_levels") {
+      EXPECT_EQ(v, 3.0);  // 4x4, 2x2, 1x1
+    }
 }
 
 TEST_F(Imagemap, FilenameIsRelativeToTheSceneFile) {

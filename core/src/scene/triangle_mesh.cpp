@@ -7,6 +7,9 @@
 
 namespace penumbra {
 
+// pbrt's parameterisation of a triangle without uv: (0,0), (1,0), (1,1) at its vertices 0, 1, 2.
+static Vec2 default_uv(int vertex) { return Vec2(vertex == 0 ? 0.f : 1.f, vertex == 2 ? 1.f : 0.f); }
+
 Vec3 TriangleMesh::position(size_t i, const Vec3& b) const {
   const uint32_t* v = &indices[3 * i];
   return b.x * P[v[0]] + b.y * P[v[1]] + b.z * P[v[2]];
@@ -76,7 +79,7 @@ PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, 
 
 void TriangleMesh::uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const {
   const uint32_t* v = &indices[3 * i];
-  Vec2 uv0(0.f, 0.f), uv1(1.f, 0.f), uv2(1.f, 1.f);  // pbrt's default parameterisation
+  Vec2 uv0 = default_uv(0), uv1 = default_uv(1), uv2 = default_uv(2);
   if (!uv.empty()) uv0 = uv[v[0]], uv1 = uv[v[1]], uv2 = uv[v[2]];
   // p - p2 = (u - u2) dpdu + (v - v2) dpdv for the two edges to vertex 2, solved for dpdu, dpdv.
   Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
@@ -167,7 +170,7 @@ Triangle::Triangle(const TriangleMesh* mesh, uint32_t index) : mesh_(mesh), inde
   const uint32_t* v = &mesh->indices[3 * index];
   for (int k = 0; k < 3; ++k) {
     p_[k] = mesh->P[v[k]];
-    uv_[k] = mesh->uv.empty() ? Vec2(k == 0 ? 0.f : 1.f, k == 2 ? 1.f : 0.f) : mesh->uv[v[k]];
+    uv_[k] = mesh->uv.empty() ? default_uv(k) : mesh->uv[v[k]];
   }
   if (mesh->N.empty()) n_flat_ = mesh->geometric_normal(index, Vec3(1.f / 3.f));  // the same for every b
   centroid_ = (p_[0] + p_[1] + p_[2]) / 3.f;

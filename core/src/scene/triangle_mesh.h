@@ -62,7 +62,7 @@ class Triangle final : public Shape {
   // Copies of what every light sample reads, so that sampling does not go through the mesh's index
   // and vertex arrays (the same values, so the same samples as reading the mesh).
   Vec3 p_[3];
-  Vec2 uv_[3];         // the mesh's, or pbrt's default (0,0), (1,0), (1,1)
+  Vec2 uv_[3];         // the mesh's, or pbrt's default (default_uv() in the .cpp)
   Vec3 n_flat_{0.f};   // the oriented face normal, for a mesh without shading normals (else zero)
   Vec3 centroid_;
   float area_, inv_area_;
