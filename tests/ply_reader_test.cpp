@@ -18,8 +18,10 @@ namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::AllOf;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const std::string kScenes = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/pbrt-v4/";
 
@@ -290,6 +292,34 @@ TEST_F(PlyTest, TruncatedBinaryData) {
   std::string s = binary_triangle_pair(true, "uchar", "int");
   s.resize(s.size() - 3);
   EXPECT_THAT(error(s), HasSubstr("mesh.ply': truncated data (the file ends early)"));
+}
+
+// CI's fuzzer found a face whose uint count (3,742,777,171) made the reader allocate 15 GB for
+// one polygon. A count is refused when its items cannot fit in the bytes left, before any
+// allocation; a count that fits but whose items are missing is still the truncation error.
+TEST_F(PlyTest, ListCountBeyondTheFileIsRefusedBeforeAllocating) {
+  for (bool little : {true, false}) {
+    std::string s = binary_triangle_pair(little, "uint", "int");
+    std::string header = s.substr(0, s.find("end_header\n") + 11);
+    std::string body = s.substr(header.size(), 4 * 5 * 4);  // the four vertices
+    put(body, uint32_t{3742777171u}, little);
+    for (int i : {0, 1, 2}) put(body, int32_t{i}, little);
+    EXPECT_THAT(error(header + body),
+                HasSubstr("truncated data (the file ends early): list property 'vertex_indices' claims "
+                          "3742777171 items, more than the 12 bytes left can hold"));
+    // Control: 3 items need 12 bytes and pass the count check; 4 need 16 and do not.
+    std::string fits = header + s.substr(header.size(), 4 * 5 * 4);
+    put(fits, uint32_t{3}, little);
+    for (int i : {0, 1, 2}) put(fits, int32_t{i}, little);
+    EXPECT_THAT(error(fits), AllOf(HasSubstr("truncated data"), Not(HasSubstr("claims"))));  // face 2 is missing
+    std::string four = header + s.substr(header.size(), 4 * 5 * 4);
+    put(four, uint32_t{4}, little);
+    for (int i : {0, 1, 2}) put(four, int32_t{i}, little);
+    EXPECT_THAT(error(four), HasSubstr("claims 4 items, more than the 12 bytes left"));
+  }
+  std::string ascii = kAsciiQuad;
+  ascii.replace(ascii.find("4 0 1 2 3"), 1, "4000000000");
+  EXPECT_THAT(error(ascii), HasSubstr("claims 4000000000 items"));
 }
 
 TEST_F(PlyTest, TruncatedAsciiData) {
