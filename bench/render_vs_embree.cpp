@@ -10,6 +10,7 @@
 //   --camera-packets  only the scene's camera rays at its film resolution (about --rays of them), one
 //                     at a time and as 8-wide packets
 //   --json            one JSON object per thread count on stdout instead of the table
+#include "number_options.h"
 #include "parser/scene_description.h"
 #include "registry/registry.h"
 #include "render/render_session.h"
@@ -187,41 +188,34 @@ CameraRays camera_rays(RTCScene scene, const Camera& camera, Point2i res, int th
 }  // namespace
 
 int main(int argc, char** argv) {
-  int spp = 32, res = 256, rounds = 5;
+  int spp = 32, res = 256, rounds = 5, threads_option = 0;
   size_t n_rays = 2'000'000;
   bool raw_only = false, json = false, camera_packets = false;
   std::string scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
-  std::vector<int> thread_counts = {1, 2};
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--raw-only")) { raw_only = true; continue; }
-    if (!std::strcmp(argv[i], "--json")) { json = true; continue; }
-    if (!std::strcmp(argv[i], "--camera-packets")) { camera_packets = true; continue; }
-    if (i + 1 >= argc) {
-      fmt::print(stderr, "penumbra-bench-render: {} needs a value\n", argv[i]);
-      return 2;
-    }
-    // Counts must be whole positive numbers; anything else is refused, naming the option.
-    auto count = [&](const char* option) -> long long {
-      char* end = nullptr;
-      long long v = std::strtoll(argv[i + 1], &end, 10);
-      if (end == argv[i + 1] || *end != '\0' || v <= 0 || v > 1'000'000'000'000LL) {
-        fmt::print(stderr, "penumbra-bench-render: {} needs a positive whole number, got '{}'\n", option, argv[i + 1]);
-        std::exit(2);
-      }
-      return v;
-    };
-    if (!std::strcmp(argv[i], "--spp")) spp = static_cast<int>(std::min(count("--spp"), 1LL << 30));
-    else if (!std::strcmp(argv[i], "--res")) res = static_cast<int>(std::min(count("--res"), 1LL << 16));
-    else if (!std::strcmp(argv[i], "--threads")) thread_counts = {static_cast<int>(std::min(count("--threads"), 4096LL))};
-    else if (!std::strcmp(argv[i], "--scene")) scene_file = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--rays")) n_rays = static_cast<size_t>(count("--rays"));
-    else if (!std::strcmp(argv[i], "--rounds")) rounds = static_cast<int>(std::min(count("--rounds"), 1000LL));
-    else {
-      fmt::print(stderr, "penumbra-bench-render: unknown option {}\n", argv[i]);
-      return 2;
-    }
-    ++i;
+  CLI::App app{"The path tracer's ray rate against raw Embree on the same geometry"};
+  app.add_option("--scene", scene_file, "pbrt-v4 scene file (default: the bundled Cornell box)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--threads", threads_option, "one thread count (default: 1, then 2)")
+      ->check(cli::whole_number(1, 4096, "a whole number of threads from 1 to 4096"));
+  app.add_option("--spp", spp, "samples per pixel of each render (default 32)")->check(cli::positive_whole_number());
+  app.add_option("--res", res, "square film resolution (default 256)")
+      ->check(cli::whole_number(1, 65536, "a whole number of pixels from 1 to 65536"));
+  app.add_option("--rays", n_rays, "rays of each raw Embree measurement (default 2000000)")
+      ->check(cli::whole_number(1, 1'000'000'000, "a whole number of rays from 1 to 10^9"));
+  app.add_option("--rounds", rounds, "alternated rounds of render and raw Embree (default 5)")
+      ->check(cli::whole_number(1, 1000, "a whole number of rounds from 1 to 1000"));
+  app.add_flag("--raw-only", raw_only, "only raw Embree on the scene's geometry");
+  app.add_flag("--camera-packets", camera_packets, "only the camera rays, one at a time and as 8-wide packets");
+  app.add_flag("--json", json, "one JSON object per thread count instead of the table");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    fmt::print(stderr, "penumbra-bench-render: {}\nRun with --help for usage.\n", e.what());
+    return 2;
   }
+  std::vector<int> thread_counts = threads_option > 0 ? std::vector<int>{threads_option} : std::vector<int>{1, 2};
   try {
     SceneDescription desc = parse_scene_file(scene_file);
     Registry registry(Registry::default_search_dirs());

@@ -148,6 +148,38 @@ TEST(BadInput, CommandLineNumbersAreValidatedWithRangesInWords) {
   EXPECT_THAT(r.err, HasSubstr("--time: expected a positive number of seconds, got 'nan'"));
 }
 
+// The programs beside penumbra read their numbers with the same validators and exit 2 on a bad one
+// (they used atoi/atof: "64x" was 64, "abc" degrees were 0).
+TEST(BadInput, ToolNumbersAreValidatedAsTheProgramsAre) {
+  std::string dir = test::temp_dir("tool-numbers");
+  std::string sky = dir + "/sky.exr";
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  } cases[] = {
+      {{sky, "64x", "32"}, "width: expected a whole number from 8 to 65536, got '64x'"},
+      {{sky, "4", "32"}, "width: expected a whole number from 8 to 65536, got '4', which is out of that range"},
+      {{sky, "64", "32", "abc"}, "sun_elevation: expected a finite number of degrees, got 'abc'"},
+      {{sky, "64", "32", "10", "nan"}, "sun_azimuth: expected a finite number of degrees, got 'nan'"},
+      {{sky, "64", "32", "10", "20", "-5"}, "sun_radiance: expected a positive number, got '-5', which is not above zero"},
+  };
+  for (const Case& c : cases) {
+    test::CommandResult r = test::run_tool("penumbra-make-sky", c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.message;
+    EXPECT_THAT(r.err, HasSubstr(c.message));
+    EXPECT_FALSE(fs::exists(sky)) << c.message;
+  }
+  // Control: good numbers (a negative elevation included) write the image.
+  test::CommandResult r = test::run_tool("penumbra-make-sky", {sky, "16", "8", "-10", "20", "5"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(sky));
+  // penumbra envmap --size is a whole number too (CLI11's PositiveNumber took 1e3 and 1.5).
+  r = test::run_penumbra({"envmap", sky, dir + "/square.exr", "--to", "equalarea", "--size", "1.5"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--size: expected a positive whole number (at most 2^31 - 1), got '1.5'"));
+  EXPECT_FALSE(fs::exists(dir + "/square.exr"));
+}
+
 // ---- pbrt's habits -----------------------------------------------------------------------------
 
 TEST(BadInput, PbrtStyleCommandLineRendersTheScene) {

@@ -12,26 +12,35 @@
 #include <penumbra/image.h>
 #include <penumbra/math.h>
 
+#include "number_options.h"
+
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 
 using namespace penumbra;
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: %s OUT.exr [WIDTH HEIGHT SUN_ELEVATION_DEG SUN_AZIMUTH_DEG SUN_RADIANCE]\n", argv[0]);
-    return 1;
+  std::string out;
+  int w = 256, h = 128;
+  double elevation_deg = 35.0, azimuth_deg = 60.0, sun_radiance = 1500.0;
+  CLI::App app{"Writes the synthetic equirectangular sky of the environment-lit scenes"};
+  app.add_option("out", out, "image to write (.exr, .pfm, .hdr, ...)")->required();
+  app.add_option("width", w, "columns (default 256)")->check(cli::whole_number(8, 65536, "a whole number from 8 to 65536"));
+  app.add_option("height", h, "rows (default 128)")->check(cli::whole_number(4, 32768, "a whole number from 4 to 32768"));
+  app.add_option("sun_elevation", elevation_deg, "degrees above the horizon (default 35)")->check(cli::finite_number("degrees"));
+  app.add_option("sun_azimuth", azimuth_deg, "degrees from +x towards +y (default 60)")->check(cli::finite_number("degrees"));
+  app.add_option("sun_radiance", sun_radiance, "radiance of the sun disk (default 1500)")->check(cli::positive_number());
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "error: %s\nRun with --help for usage.\n", e.what());
+    return 2;
   }
-  int w = argc > 2 ? std::atoi(argv[2]) : 256, h = argc > 3 ? std::atoi(argv[3]) : 128;
-  float elevation = radians(argc > 4 ? std::atof(argv[4]) : 35.f);
-  float azimuth = radians(argc > 5 ? std::atof(argv[5]) : 60.f);
-  float sun_L = argc > 6 ? std::atof(argv[6]) : 1500.f;
+  const float elevation = radians(static_cast<float>(elevation_deg)), azimuth = radians(static_cast<float>(azimuth_deg));
+  const float sun_L = static_cast<float>(sun_radiance);
   const float sun_radius = radians(1.6f);  // a little over a texel at 256 x 128, like a small sun
-  if (w < 8 || h < 4) {
-    std::fprintf(stderr, "error: image too small\n");
-    return 1;
-  }
   Vec3 sun(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
 
   ImageRgb img;
@@ -56,7 +65,7 @@ int main(int argc, char** argv) {
       p[0] = L.r, p[1] = L.g, p[2] = L.b;
     }
   try {
-    write_image(argv[1], img);
+    write_image(out, img);
   } catch (const Error& e) {
     std::fprintf(stderr, "%s\n", e.formatted().c_str());
     return 1;

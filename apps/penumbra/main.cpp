@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
   envmap->add_option("--to", env.to, "mapping to write: equalarea (pbrt-v4's) or equirectangular")->required();
   envmap->add_option("--from", env.from, "mapping of the input (default: square = equalarea, 2:1 = equirectangular)");
   envmap->add_option("--size", env.size, "output width: N x N equal area, N x N/2 equirectangular (default: as many texels as the input)")
-      ->check(CLI::PositiveNumber);
+      ->check(penumbra::cli::positive_whole_number());
 
   std::vector<std::string> plugin_dirs;
   auto* plugins = app.add_subcommand("plugins", "List plugins with their parameters");

@@ -38,10 +38,12 @@ std::string read_file(const std::string& path) {
   return ss.str();
 }
 
-CommandResult run_penumbra(const std::vector<std::string>& args, const std::string& env) {
+namespace {
+
+CommandResult run_program(const std::string& program, const std::vector<std::string>& args, const std::string& env) {
   static int counter = 0;
   std::string dir = temp_dir("cmd" + std::to_string(counter++));
-  std::string cmd = env + (env.empty() ? "" : " ") + quote(PENUMBRA_BINARY);
+  std::string cmd = env + (env.empty() ? "" : " ") + quote(program);
   for (const auto& a : args) cmd += " " + quote(a);
   cmd += " >" + quote(dir + "/out") + " 2>" + quote(dir + "/err") + " </dev/null";
   int status = std::system(cmd.c_str());
@@ -50,6 +52,16 @@ CommandResult run_penumbra(const std::vector<std::string>& args, const std::stri
   r.out = read_file(dir + "/out");
   r.err = read_file(dir + "/err");
   return r;
+}
+
+}  // namespace
+
+CommandResult run_penumbra(const std::vector<std::string>& args, const std::string& env) {
+  return run_program(PENUMBRA_BINARY, args, env);
+}
+
+CommandResult run_tool(const std::string& name, const std::vector<std::string>& args) {
+  return run_program((fs::path(PENUMBRA_BINARY).parent_path() / name).string(), args, "");
 }
 
 }  // namespace penumbra::test

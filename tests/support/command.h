@@ -13,6 +13,8 @@ struct CommandResult {
 
 /// Runs build/bin/penumbra with `args` (each shell-quoted) and optional environment assignments.
 CommandResult run_penumbra(const std::vector<std::string>& args, const std::string& env = "");
+/// Runs another program of penumbra's folder (e.g. "penumbra-make-sky") the same way.
+CommandResult run_tool(const std::string& name, const std::vector<std::string>& args);
 
 /// A fresh temporary folder for one test.
 std::string temp_dir(const std::string& name);

@@ -42,8 +42,10 @@ CLI::Validator seed_number() {
   return whole_number(0, UINT32_MAX, "a whole number from 0 to 2^32 - 1");
 }
 
-CLI::Validator positive_number(const std::string& unit) {
-  std::string words = unit.empty() ? "a positive number" : "a positive number of " + unit;
+namespace {
+
+// A finite number in decimal or scientific notation, above zero when `positive`.
+CLI::Validator real_number(const std::string& words, bool positive, const std::string& name) {
   return CLI::Validator(
       [=](std::string& text) -> std::string {
         char* end = nullptr;
@@ -51,10 +53,21 @@ CLI::Validator positive_number(const std::string& unit) {
         if (text.empty() || end != text.c_str() + text.size() || std::isnan(v))
           return fmt::format("expected {}, got {}", words, quote_value(text));
         if (!std::isfinite(v)) return fmt::format("expected {}, got {}, which is not finite", words, quote_value(text));
-        if (!(v > 0.0)) return fmt::format("expected {}, got {}, which is not above zero", words, quote_value(text));
+        if (positive && !(v > 0.0))
+          return fmt::format("expected {}, got {}, which is not above zero", words, quote_value(text));
         return "";
       },
-      "", "positive number");
+      "", name);
+}
+
+}  // namespace
+
+CLI::Validator positive_number(const std::string& unit) {
+  return real_number(unit.empty() ? "a positive number" : "a positive number of " + unit, true, "positive number");
+}
+
+CLI::Validator finite_number(const std::string& unit) {
+  return real_number(unit.empty() ? "a finite number" : "a finite number of " + unit, false, "number");
 }
 
 }  // namespace penumbra::cli

@@ -1,6 +1,8 @@
-// Validators for the numbers given on the command line. CLI11's own range validators print their
-// bounds as numbers (PositiveNumber's upper bound is DBL_MAX, 309 digits) and let NaN through; these
-// check the whole text, refuse NaN and infinity, and state the accepted range in words:
+// Validators for the numbers given on the command line, linked as the library target
+// penumbra-number-options by the penumbra program, penumbra-make-sky and the benchmark programs.
+// CLI11's own range validators print their bounds as numbers (PositiveNumber's upper bound is
+// DBL_MAX, 309 digits) and let NaN through; these check the whole text, refuse NaN and infinity,
+// and state the accepted range in words:
 // "--spp: expected a positive whole number, got '0'".
 #pragma once
 
@@ -23,5 +25,7 @@ CLI::Validator seed_number();                // 0 .. 2^32 - 1
 /// A finite number greater than zero (decimal or scientific notation); `unit` ends the message,
 /// e.g. "seconds" gives "expected a positive number of seconds".
 CLI::Validator positive_number(const std::string& unit = "");
+/// Any finite number (decimal or scientific notation), e.g. an angle in degrees.
+CLI::Validator finite_number(const std::string& unit = "");
 
 }  // namespace penumbra::cli
