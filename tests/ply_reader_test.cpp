@@ -320,6 +320,11 @@ TEST_F(PlyTest, ListCountBeyondTheFileIsRefusedBeforeAllocating) {
   std::string ascii = kAsciiQuad;
   ascii.replace(ascii.find("4 0 1 2 3"), 1, "4000000000");
   EXPECT_THAT(error(ascii), HasSubstr("claims 4000000000 items"));
+  // Ascii items take a character and a separator, but the last: "0 1 2" holds 3 and not 4.
+  std::string header = kAsciiQuad;
+  header.resize(header.find("4 0 1 2 3"));
+  EXPECT_EQ(read(header + "3 0 1 2").indices.size(), 3u);
+  EXPECT_THAT(error(header + "4 0 1 2"), HasSubstr("claims 4 items, more than the 6 bytes left"));
 }
 
 TEST_F(PlyTest, TruncatedAsciiData) {

@@ -183,14 +183,15 @@ class DataReader {
   double read(Scalar t) { return format_ == Format::Ascii ? read_ascii() : read_binary(t); }
 
   // A list's length, checked so that a corrupt count cannot run away: its items must fit in the
-  // bytes that are left (each binary item takes its type's size, each ascii one at least a byte),
-  // so a 4-byte count cannot make the caller reserve gigabytes for a list the file cannot hold.
+  // bytes that are left (each binary item takes its type's size; each ascii one a character and a
+  // separator, but the file's last), so a 4-byte count cannot make the caller reserve gigabytes
+  // for a list the file cannot hold.
   size_t read_count(const Property& p) {
     double n = read(p.count_type);
     if (n < 0 || n != static_cast<double>(static_cast<long long>(n)))
       ctx_.fail(fmt::format("bad list length {} in property '{}'", n, p.name));
     size_t left = data_.size() - pos_;
-    size_t fits = format_ == Format::Ascii ? left : left / size_of(p.type);
+    size_t fits = format_ == Format::Ascii ? (left + 1) / 2 : left / size_of(p.type);
     if (n > static_cast<double>(fits))
       ctx_.fail(fmt::format("truncated data (the file ends early): list property '{}' claims {} items, more "
                             "than the {} bytes left can hold",
