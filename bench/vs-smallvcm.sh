@@ -6,11 +6,13 @@
 #   passes/s  SmallVCM: iterations over its process's wall time (it finishes the iteration it began,
 #             so the overshoot is counted fairly); Penumbra: passes over its rendering seconds
 #   relMSE    both images against bench/references/<scene>.exr (penumbra-bench-image-errors)
-# and the ratios Penumbra / SmallVCM. docs/benchmarks.md, "Against SmallVCM on the same machine",
-# says how SmallVCM must be prepared: three scene configurations added as its scenes 4, 5 and 6 (both
-# small spheres and a diffuse floor under the ceiling light, the point light and the background light)
-# and its iteration count printed as "Iterations: N". Build both the same way (both portable, or both
-# -march=native): the flag matters more to SmallVCM (same section).
+# and the ratios Penumbra / SmallVCM: of the medians, and per run, of each SmallVCM render and the
+# Penumbra render after it (the median of those pairs and their range). docs/benchmarks.md,
+# "Against SmallVCM on the same machine", says how SmallVCM must be prepared: three scene
+# configurations added as its scenes 4, 5 and 6 (both small spheres and a diffuse floor under the
+# ceiling light, the point light and the background light) and its iteration count printed as
+# "Iterations: N". Build both the same way (both portable, or both -march=native): the flag
+# matters more to SmallVCM (same section).
 #
 # Usage: bench/vs-smallvcm.sh --smallvcm BIN [--runs N] [--time S] [--threads N] [--algorithms pt,bpt,ppm]
 #                             [--scenes area,point,env] [--pause S] [--keep DIR] [--build DIR]
@@ -119,20 +121,30 @@ done
 import csv, statistics, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 names = {"pt": "path", "bpt": "bdpt", "ppm": "sppm"}
-print("| scene | algorithm | SmallVCM passes/s | Penumbra passes/s | ratio | SmallVCM relMSE | Penumbra relMSE | ratio |")
-print("|---|---|---|---|---|---|---|---|")
+print("| scene | algorithm | SmallVCM passes/s | Penumbra passes/s | ratio | pairs [min, max] "
+      "| SmallVCM relMSE | Penumbra relMSE | ratio | pairs [min, max] |")
+print("|---|---|---|---|---|---|---|---|---|---|")
 cells = []
 for r in rows:
     if (r["scene"], r["algorithm"]) not in cells:
         cells.append((r["scene"], r["algorithm"]))
+rate = lambda r: float(r["passes"]) / float(r["seconds"])
+rel = lambda r: float(r["relmse"])
 for scene, alg in cells:
+    runs = {}
+    for r in rows:
+        if r["scene"] == scene and r["algorithm"] == alg:
+            runs.setdefault(r["run"], {})[r["renderer"]] = r
     def med(renderer, f):
-        return statistics.median(f(r) for r in rows
-                                 if r["renderer"] == renderer and r["scene"] == scene and r["algorithm"] == alg)
-    rate = lambda r: float(r["passes"]) / float(r["seconds"])
-    rel = lambda r: float(r["relmse"])
+        return statistics.median(f(pair[renderer]) for pair in runs.values() if renderer in pair)
+    # Each run's SmallVCM render and the Penumbra render right after it share the machine's state:
+    # the median of their ratios, with the range, says how far a conclusion would move on a rerun.
+    def pairs(f):
+        q = [f(p["penumbra"]) / f(p["smallvcm"]) for p in runs.values() if "penumbra" in p and "smallvcm" in p]
+        return f"{statistics.median(q):.2f} [{min(q):.2f}, {max(q):.2f}]" if q else "-"
     sv, pn = med("smallvcm", rate), med("penumbra", rate)
     svr, pnr = med("smallvcm", rel), med("penumbra", rel)
-    print(f"| {scene} | {alg} / {names[alg]} | {sv:.2f} | {pn:.2f} | {pn / sv:.2f} | {svr:.4g} | {pnr:.4g} | {pnr / svr:.2f} |")
+    print(f"| {scene} | {alg} / {names[alg]} | {sv:.2f} | {pn:.2f} | {pn / sv:.2f} | {pairs(rate)} "
+          f"| {svr:.4g} | {pnr:.4g} | {pnr / svr:.2f} | {pairs(rel)} |")
 EOF
 echo "vs-smallvcm.sh: every render's figures are in $csv$([ -z "$keep" ] && echo ' (removed at exit; --keep DIR keeps them)')" >&2
