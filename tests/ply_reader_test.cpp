@@ -299,23 +299,21 @@ TEST_F(PlyTest, TruncatedBinaryData) {
 // allocation; a count that fits but whose items are missing is still the truncation error.
 TEST_F(PlyTest, ListCountBeyondTheFileIsRefusedBeforeAllocating) {
   for (bool little : {true, false}) {
-    std::string s = binary_triangle_pair(little, "uint", "int");
-    std::string header = s.substr(0, s.find("end_header\n") + 11);
-    std::string body = s.substr(header.size(), 4 * 5 * 4);  // the four vertices
-    put(body, uint32_t{3742777171u}, little);
-    for (int i : {0, 1, 2}) put(body, int32_t{i}, little);
-    EXPECT_THAT(error(header + body),
+    // The header and four vertices of binary_triangle_pair(), then one face: `count`, indices 0 1 2.
+    std::string pair = binary_triangle_pair(little, "uint", "int");
+    std::string start = pair.substr(0, pair.find("end_header\n") + 11 + 4 * 5 * 4);
+    auto one_face = [&](uint32_t count) {
+      std::string s = start;
+      put(s, count, little);
+      for (int i : {0, 1, 2}) put(s, int32_t{i}, little);
+      return s;
+    };
+    EXPECT_THAT(error(one_face(3742777171u)),
                 HasSubstr("truncated data (the file ends early): list property 'vertex_indices' claims "
                           "3742777171 items, more than the 12 bytes left can hold"));
-    // Control: 3 items need 12 bytes and pass the count check; 4 need 16 and do not.
-    std::string fits = header + s.substr(header.size(), 4 * 5 * 4);
-    put(fits, uint32_t{3}, little);
-    for (int i : {0, 1, 2}) put(fits, int32_t{i}, little);
-    EXPECT_THAT(error(fits), AllOf(HasSubstr("truncated data"), Not(HasSubstr("claims"))));  // face 2 is missing
-    std::string four = header + s.substr(header.size(), 4 * 5 * 4);
-    put(four, uint32_t{4}, little);
-    for (int i : {0, 1, 2}) put(four, int32_t{i}, little);
-    EXPECT_THAT(error(four), HasSubstr("claims 4 items, more than the 12 bytes left"));
+    // Control: 3 items need 12 bytes and pass the count check (then face 2 is missing); 4 do not.
+    EXPECT_THAT(error(one_face(3)), AllOf(HasSubstr("truncated data"), Not(HasSubstr("claims"))));
+    EXPECT_THAT(error(one_face(4)), HasSubstr("claims 4 items, more than the 12 bytes left"));
   }
   std::string ascii = kAsciiQuad;
   ascii.replace(ascii.find("4 0 1 2 3"), 1, "4000000000");

@@ -16,6 +16,22 @@ std::string quote_value(const std::string& text) {
   return text.size() <= 40 ? fmt::format("'{}'", text) : fmt::format("'{}...' ({} characters)", text.substr(0, 40), text.size());
 }
 
+// A finite number in decimal or scientific notation, above zero when `positive`.
+CLI::Validator real_number(const std::string& words, bool positive, const std::string& name) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        char* end = nullptr;
+        double v = text.empty() ? 0.0 : std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size() || std::isnan(v))
+          return fmt::format("expected {}, got {}", words, quote_value(text));
+        if (!std::isfinite(v)) return fmt::format("expected {}, got {}, which is not finite", words, quote_value(text));
+        if (positive && !(v > 0.0))
+          return fmt::format("expected {}, got {}, which is not above zero", words, quote_value(text));
+        return "";
+      },
+      "", name);
+}
+
 }  // namespace
 
 CLI::Validator whole_number(int64_t lo, int64_t hi, const std::string& words) {
@@ -41,26 +57,6 @@ CLI::Validator non_negative_whole_number() { return whole_number(0, INT_MAX, "a 
 CLI::Validator seed_number() {
   return whole_number(0, UINT32_MAX, "a whole number from 0 to 2^32 - 1");
 }
-
-namespace {
-
-// A finite number in decimal or scientific notation, above zero when `positive`.
-CLI::Validator real_number(const std::string& words, bool positive, const std::string& name) {
-  return CLI::Validator(
-      [=](std::string& text) -> std::string {
-        char* end = nullptr;
-        double v = text.empty() ? 0.0 : std::strtod(text.c_str(), &end);
-        if (text.empty() || end != text.c_str() + text.size() || std::isnan(v))
-          return fmt::format("expected {}, got {}", words, quote_value(text));
-        if (!std::isfinite(v)) return fmt::format("expected {}, got {}, which is not finite", words, quote_value(text));
-        if (positive && !(v > 0.0))
-          return fmt::format("expected {}, got {}, which is not above zero", words, quote_value(text));
-        return "";
-      },
-      "", name);
-}
-
-}  // namespace
 
 CLI::Validator positive_number(const std::string& unit) {
   return real_number(unit.empty() ? "a positive number" : "a positive number of " + unit, true, "positive number");

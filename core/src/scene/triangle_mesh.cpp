@@ -115,12 +115,15 @@ ShapeSample Triangle::sample_area(Vec2 u) const {
 
 // Samples are written field by field into the object the caller returns: built whole and copied
 // out of an std::optional, they stalled store forwarding (docs/benchmarks.md, "Results built in place").
-void Triangle::area_sample_into(Vec2 u, ShapeSample& s) const {
-  Vec2 b12 = sample_uniform_triangle(u);
-  Vec3 b(1.f - b12.x - b12.y, b12.x, b12.y);
+void Triangle::fill_at(const Vec3& b, ShapeSample& s) const {
   s.p = b.x * p_[0] + b.y * p_[1] + b.z * p_[2];
   s.n = n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, b);
   s.uv = b.x * uv_[0] + b.y * uv_[1] + b.z * uv_[2];
+}
+
+void Triangle::area_sample_into(Vec2 u, ShapeSample& s) const {
+  Vec2 b12 = sample_uniform_triangle(u);
+  fill_at(Vec3(1.f - b12.x - b12.y, b12.x, b12.y), s);
   s.pdf = inv_area_;
 }
 
@@ -210,10 +213,10 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
       float sum = b1 + b2;
       b1 /= sum, b2 /= sum;
     }
-    Vec3 bary(1.f - b1 - b2, b1, b2);
-    return ShapeSample{bary.x * p0 + bary.y * p1 + bary.z * p2,
-                       n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, bary),
-                       bary.x * uv_[0] + bary.y * uv_[1] + bary.z * uv_[2], 1.f / omega};
+    std::optional<ShapeSample> out(std::in_place);
+    fill_at(Vec3(1.f - b1 - b2, b1, b2), *out);
+    out->pdf = 1.f / omega;
+    return out;
   }
   return sample_by_area(ctx, u);
 }

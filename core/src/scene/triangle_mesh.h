@@ -57,6 +57,8 @@ class Triangle final : public Shape {
   bool spherical_worthwhile(const Vec3& p) const;
   std::optional<ShapeSample> sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const;
   void area_sample_into(Vec2 u, ShapeSample& s) const;
+  /// Point, oriented normal and uv at barycentrics b, from the copies below.
+  void fill_at(const Vec3& b, ShapeSample& s) const;
   const TriangleMesh* mesh_;
   uint32_t index_;
   // Copies of what every light sample reads, so that sampling does not go through the mesh's index
