@@ -112,6 +112,15 @@ TEST(CameraImportance, SampleWiLandsWhereTheCameraRayStarted) {
       float expected_pdf = t * t / (glm::dot(ray.d, axis) * c.lens_area);
       EXPECT_NEAR(s->pdf / expected_pdf, 1.f, 1e-3f) << c.name;
       EXPECT_NEAR(s->We.x / cam.We(ray).x, 1.f, 1e-3f) << c.name;
+      // The densities it carries are pdf_we()'s for the ray it connects along, to the bit, and We
+      // is We()'s: bidirectional methods take them from here instead of calling again.
+      Ray back{s->p_lens, -s->wi, Infinity};
+      float pdf_pos = -1.f, pdf_dir = -1.f;
+      cam.pdf_we(back, &pdf_pos, &pdf_dir);
+      EXPECT_EQ(s->pdf_pos, pdf_pos) << c.name;
+      EXPECT_EQ(s->pdf_dir, pdf_dir) << c.name;
+      EXPECT_GT(s->pdf_dir, 0.f) << c.name;
+      EXPECT_EQ(s->We.x, cam.We(back).x) << c.name;
     }
   }
 }

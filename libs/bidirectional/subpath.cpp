@@ -698,10 +698,8 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       c.L = Rgb(0.f);
       return c;
     }
-    // The lens vertex's densities only once the connection counts (a blocked one skips them).
-    float pdf_pos, pdf_dir;
-    scene.camera().pdf_we(Ray{cam.p, -cw->wi}, &pdf_pos, &pdf_dir);
-    cam.pdf_fwd = pdf_pos;
+    // The lens vertex's densities: what pdf_we() gives for the ray lens -> qs, from sample_wi().
+    cam.pdf_fwd = cw->pdf_pos;
     c.has_sampled = true;
     c.splat = true;
     c.p_raster = cw->p_raster;
@@ -710,11 +708,11 @@ Connection connect(const Context& ctx, const Vertex* light, int s, const Vertex*
       c.weighted = c.L;
       return c;
     }
-    // s >= 2: qs is a surface vertex with a predecessor. The lens density towards qs is the one
-    // pdf_we() just gave for the direction lens -> qs.
+    // s >= 2: qs is a surface vertex with a predecessor. The lens density towards qs is the
+    // directional one of the ray lens -> qs.
     Patch patch;
     surface_pdf_pair_from_prev(qs, light[s - 2], cam, &patch.light_s, &patch.camera_s2);
-    patch.camera_s1 = convert_density(pdf_dir, cam, qs);
+    patch.camera_s1 = convert_density(cw->pdf_dir, cam, qs);
     patch.nee_ratio = cached_nee_ratio(light, s, nullptr, light[0], light[1]);
     c.weight = weight_with(ctx, light, s, camera, t, nullptr, &cam, Technique::Regular, patch);
     c.weighted = c.L * static_cast<float>(c.weight);

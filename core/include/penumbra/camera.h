@@ -23,6 +23,10 @@ struct CameraWiSample {
   float pdf = 0.f;   // density of the lens point, per unit solid angle at the reference point
   Vec2 p_raster{0.f};  // where the connection lands on the film
   Vec3 p_lens{0.f};  // world-space lens point (the shadow ray's target; not on any surface)
+  // What pdf_we() gives for the ray from p_lens towards the reference point (-wi), so that a
+  // bidirectional connection through the lens needs no second call.
+  float pdf_pos = 0.f;
+  float pdf_dir = 0.f;
 };
 
 class Camera {

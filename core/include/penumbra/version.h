@@ -24,7 +24,8 @@
 //     TextureEvalContext::wavelengths, TexturedRgb kinds (RgbKind), CreateContext::spectral,
 //     SampleIntegrator::supports_spectral(), ParamSet::set_bool.
 // 12: SampleIntegrator::wavelengths_per_pass(), Pass::wavelengths.
-#define PENUMBRA_SDK_VERSION 12
+// 13: CameraWiSample::pdf_pos and pdf_dir.
+#define PENUMBRA_SDK_VERSION 13
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

@@ -117,27 +117,39 @@ Vec3 PerspectiveCamera::to_camera_point(const Vec3& p) const {
   return p == lens_centre_ ? lens_centre_camera_ : Vec3(from_world_ * Vec4(p, 1.f));
 }
 
-Rgb PerspectiveCamera::We(const Ray& ray, Vec2* p_raster) const {
+// The cosine between the camera's axis and a ray leaving a lens point, and where the ray lands on
+// the film; false when it misses the film (with its margin).
+bool PerspectiveCamera::film_cos(const Ray& ray, Vec2* p_raster, float* cos_theta) const {
   Vec3 o = to_camera_point(ray.o);
   Vec3 d = glm::normalize(Vec3(from_world_ * Vec4(ray.d, 0.f)));
-  float cos_theta;
-  if (!raster_of(o, d, p_raster, &cos_theta)) return Rgb(0.f);
-  // On the z = 1 plane dA = r^2 / cos(theta) dw with r = 1 / cos(theta), so a density uniform over
-  // the film is 1 / (A cos^3) per solid angle; dividing once more by cos(theta) normalises We cos.
+  return raster_of(o, d, p_raster, cos_theta);
+}
+
+// On the z = 1 plane dA = r^2 / cos(theta) dw with r = 1 / cos(theta), so a density uniform over
+// the film is 1 / (A cos^3) per solid angle; dividing once more by cos(theta) normalises We cos.
+float PerspectiveCamera::importance_at(float cos_theta) const {
   float cos2 = cos_theta * cos_theta;
-  return Rgb(1.f / (film_area_ * lens_area_ * cos2 * cos2));
+  return 1.f / (film_area_ * lens_area_ * cos2 * cos2);
+}
+
+float PerspectiveCamera::pdf_dir_at(float cos_theta) const {
+  return 1.f / (film_area_ * cos_theta * cos_theta * cos_theta);
+}
+
+Rgb PerspectiveCamera::We(const Ray& ray, Vec2* p_raster) const {
+  float cos_theta;
+  if (!film_cos(ray, p_raster, &cos_theta)) return Rgb(0.f);
+  return Rgb(importance_at(cos_theta));
 }
 
 void PerspectiveCamera::pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) const {
-  Vec3 o = to_camera_point(ray.o);
-  Vec3 d = glm::normalize(Vec3(from_world_ * Vec4(ray.d, 0.f)));
   float cos_theta;
-  if (!raster_of(o, d, nullptr, &cos_theta)) {
+  if (!film_cos(ray, nullptr, &cos_theta)) {
     *pdf_pos = *pdf_dir = 0.f;
     return;
   }
   *pdf_pos = 1.f / lens_area_;
-  *pdf_dir = 1.f / (film_area_ * cos_theta * cos_theta * cos_theta);
+  *pdf_dir = pdf_dir_at(cos_theta);
 }
 
 std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Vec2 u) const {
@@ -152,15 +164,18 @@ std::optional<CameraWiSample> PerspectiveCamera::sample_wi(const Vec3& p_ref, Ve
   Vec3 wi = d / std::sqrt(dist2);
   float cos_lens = std::abs(glm::dot(axis_, wi));
   if (cos_lens == 0.f) return out;
+  // We and pdf_we of the ray from the lens point towards p_ref, from one film_cos().
   Vec2 p_raster(0.f);
-  Rgb importance = We(Ray{p_lens, -wi, Infinity}, &p_raster);
-  if (is_black(importance)) return out;
+  float cos_theta;
+  if (!film_cos(Ray{p_lens, -wi, Infinity}, &p_raster, &cos_theta)) return out;
   CameraWiSample& s = out.emplace();
   s.p_lens = p_lens;
   s.wi = wi;
-  s.We = importance;
+  s.We = Rgb(importance_at(cos_theta));
   s.p_raster = p_raster;
   s.pdf = dist2 / (cos_lens * lens_area_);  // uniform by lens area, converted to solid angle at p_ref
+  s.pdf_pos = 1.f / lens_area_;
+  s.pdf_dir = pdf_dir_at(cos_theta);
   return out;
 }
 

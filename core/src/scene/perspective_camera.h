@@ -31,6 +31,9 @@ class PerspectiveCamera final : public Camera {
   /// Raster position of the camera-space ray (o, unit d), through the plane in focus; false when it
   /// misses the film and its filter margin. `cos_theta` receives d.z.
   bool raster_of(const Vec3& o, const Vec3& d, Vec2* p_raster, float* cos_theta) const;
+  bool film_cos(const Ray& ray, Vec2* p_raster, float* cos_theta) const;
+  float importance_at(float cos_theta) const;  // We at the given cosine (one value for every channel)
+  float pdf_dir_at(float cos_theta) const;     // pdf_we()'s directional density at the given cosine
   /// A world-space point in camera space.
   Vec3 to_camera_point(const Vec3& p) const;
 

@@ -23,8 +23,11 @@ std::optional<float> Sphere::intersect(const Ray& ray, float t_min, float t_max)
   if (!(a > 0.0)) return std::nullopt;
   double b = glm::dot(oc, d);  // half the linear coefficient
   double r = radius_;
-  glm::dvec3 v = oc - (b / a) * d;  // closest approach of the line to the centre
-  double disc = a * (r * r - glm::dot(v, v));  // b^2 - a c, without the cancellation
+  // b^2 - a c without the cancellation: a |v|^2 = |oc x d|^2 (Lagrange's identity), v the line's
+  // closest approach to the centre. The cross product needs no division, so a miss is known after a
+  // few products; the division by a that v would take sat on the path of every query (perf).
+  glm::dvec3 w = glm::cross(oc, d);
+  double disc = a * r * r - glm::dot(w, w);
   if (disc < 0.0) return std::nullopt;
   double q = -(b + std::copysign(std::sqrt(disc), b));
   double c = glm::dot(oc, oc) - r * r;
