@@ -7,7 +7,9 @@
 #             so the overshoot is counted fairly); Penumbra: passes over its rendering seconds
 #   relMSE    both images against bench/references/<scene>.exr (penumbra-bench-image-errors)
 # and the ratios Penumbra / SmallVCM: of the medians, and per run, of each SmallVCM render and the
-# Penumbra render after it (the median of those pairs and their range). docs/benchmarks.md,
+# Penumbra render after it (the median of those pairs, a distribution-free interval of at least 95 %
+# for that median from the pairs' order statistics, which needs 6 runs or more, and their range). A
+# cell is decided only when its interval lies on one side of 1. docs/benchmarks.md,
 # "Against SmallVCM on the same machine", says how SmallVCM must be prepared: three scene
 # configurations added as its scenes 4, 5 and 6 (both small spheres and a diffuse floor under the
 # ceiling light, the point light and the background light) and its iteration count printed as
@@ -118,11 +120,26 @@ print(d['samples_per_pixel'], d['seconds'])" "$work/$name.json")
 done
 
 "$py" - "$csv" <<'EOF'
-import csv, statistics, sys
+import csv, math, statistics, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 names = {"pt": "path", "bpt": "bdpt", "ppm": "sppm"}
-print("| scene | algorithm | SmallVCM passes/s | Penumbra passes/s | ratio | pairs [min, max] "
-      "| SmallVCM relMSE | Penumbra relMSE | ratio | pairs [min, max] |")
+
+def median_interval(q, level=0.95):
+    """The narrowest symmetric pair of order statistics [q(j), q(n-1-j)] that covers the median with
+    probability >= level whatever the distribution: the count of values below the median is
+    Binomial(n, 1/2). None when n is too small for the level (n < 6 at 95 %)."""
+    q = sorted(q)
+    n = len(q)
+    best = None
+    for j in range(n // 2 + 1):
+        coverage = sum(math.comb(n, i) for i in range(j + 1, n - j)) / 2 ** n
+        if coverage < level:
+            break
+        best = (q[j], q[n - 1 - j])
+    return best
+
+print("| scene | algorithm | SmallVCM passes/s | Penumbra passes/s | ratio | pairs: median [95 % interval] (range) "
+      "| SmallVCM relMSE | Penumbra relMSE | ratio | pairs: median [95 % interval] (range) |")
 print("|---|---|---|---|---|---|---|---|---|---|")
 cells = []
 for r in rows:
@@ -138,10 +155,15 @@ for scene, alg in cells:
     def med(renderer, f):
         return statistics.median(f(pair[renderer]) for pair in runs.values() if renderer in pair)
     # Each run's SmallVCM render and the Penumbra render right after it share the machine's state:
-    # the median of their ratios, with the range, says how far a conclusion would move on a rerun.
+    # the median of their ratios, its interval and their range say how far a conclusion would move
+    # on a rerun.
     def pairs(f):
         q = [f(p["penumbra"]) / f(p["smallvcm"]) for p in runs.values() if "penumbra" in p and "smallvcm" in p]
-        return f"{statistics.median(q):.2f} [{min(q):.2f}, {max(q):.2f}]" if q else "-"
+        if not q:
+            return "-"
+        ci = median_interval(q)
+        interval = f"[{ci[0]:.2f}, {ci[1]:.2f}]" if ci else "[-]"
+        return f"{statistics.median(q):.2f} {interval} ({min(q):.2f}-{max(q):.2f})"
     sv, pn = med("smallvcm", rate), med("penumbra", rate)
     svr, pnr = med("smallvcm", rel), med("penumbra", rel)
     print(f"| {scene} | {alg} / {names[alg]} | {sv:.2f} | {pn:.2f} | {pn / sv:.2f} | {pairs(rate)} "
