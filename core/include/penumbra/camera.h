@@ -48,7 +48,8 @@ class Camera {
   /// solid angle of its direction (0 outside the film).
   virtual void pdf_we(const Ray& ray, float* pdf_pos, float* pdf_dir) const { *pdf_pos = *pdf_dir = 0.f; }
   /// Chooses a lens point (u: uniform over the lens) seen from `p_ref`. Empty when the connection
-  /// misses the film.
+  /// misses the film. A camera that implements it also fills the sample's pdf_pos and pdf_dir with
+  /// what pdf_we() gives for the ray from the lens point towards p_ref.
   virtual std::optional<CameraWiSample> sample_wi(const Vec3& p_ref, Vec2 u) const { return std::nullopt; }
   /// Whether light paths can connect to the lens (We, pdf_we and sample_wi describe it). False for a
   /// camera whose rays are a delta in direction (orthographic): bidirectional methods then treat the

@@ -31,6 +31,7 @@ class PerspectiveCamera final : public Camera {
   /// Raster position of the camera-space ray (o, unit d), through the plane in focus; false when it
   /// misses the film and its filter margin. `cos_theta` receives d.z.
   bool raster_of(const Vec3& o, const Vec3& d, Vec2* p_raster, float* cos_theta) const;
+  /// raster_of() for a world-space ray leaving a lens point: what We, pdf_we and sample_wi share.
   bool film_cos(const Ray& ray, Vec2* p_raster, float* cos_theta) const;
   float importance_at(float cos_theta) const;  // We at the given cosine (one value for every channel)
   float pdf_dir_at(float cos_theta) const;     // pdf_we()'s directional density at the given cosine
