@@ -207,14 +207,8 @@ int main(int argc, char** argv) {
   app.add_flag("--raw-only", raw_only, "only raw Embree on the scene's geometry");
   app.add_flag("--camera-packets", camera_packets, "only the camera rays, one at a time and as 8-wide packets");
   app.add_flag("--json", json, "one JSON object per thread count instead of the table");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    fmt::print(stderr, "penumbra-bench-render: {}\nRun with --help for usage.\n", e.what());
-    return 2;
-  }
+  if (std::optional<int> exit_code = cli::parse_tool_options(app, argc, argv, "penumbra-bench-render:"))
+    return *exit_code;
   std::vector<int> thread_counts = threads_option > 0 ? std::vector<int>{threads_option} : std::vector<int>{1, 2};
   try {
     SceneDescription desc = parse_scene_file(scene_file);

@@ -66,4 +66,16 @@ CLI::Validator finite_number(const std::string& unit) {
   return real_number(unit.empty() ? "a finite number" : "a finite number of " + unit, false, "number");
 }
 
+std::optional<int> parse_tool_options(CLI::App& app, int argc, char** argv, const std::string& prefix) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    fmt::print(stderr, "{} {}\nRun with --help for usage.\n", prefix, e.what());
+    return 2;
+  }
+  return std::nullopt;
+}
+
 }  // namespace penumbra::cli

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace penumbra::cli {
@@ -27,5 +28,11 @@ CLI::Validator seed_number();                // 0 .. 2^32 - 1
 CLI::Validator positive_number(const std::string& unit = "");
 /// Any finite number (decimal or scientific notation), e.g. an angle in degrees.
 CLI::Validator finite_number(const std::string& unit = "");
+
+/// How the programs beside penumbra (penumbra-make-sky, the benchmark programs) read their command
+/// line: parses `app`; on --help prints the usage and returns 0, on a bad option prints
+/// "`prefix` MESSAGE" and a pointer to --help on stderr and returns 2; otherwise returns nothing and
+/// the program goes on.
+std::optional<int> parse_tool_options(CLI::App& app, int argc, char** argv, const std::string& prefix);
 
 }  // namespace penumbra::cli

@@ -30,14 +30,7 @@ int main(int argc, char** argv) {
   app.add_option("sun_elevation", elevation_deg, "degrees above the horizon (default 35)")->check(cli::finite_number("degrees"));
   app.add_option("sun_azimuth", azimuth_deg, "degrees from +x towards +y (default 60)")->check(cli::finite_number("degrees"));
   app.add_option("sun_radiance", sun_radiance, "radiance of the sun disk (default 1500)")->check(cli::positive_number());
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "error: %s\nRun with --help for usage.\n", e.what());
-    return 2;
-  }
+  if (std::optional<int> exit_code = cli::parse_tool_options(app, argc, argv, "error:")) return *exit_code;
   const float elevation = radians(static_cast<float>(elevation_deg)), azimuth = radians(static_cast<float>(azimuth_deg));
   const float sun_L = static_cast<float>(sun_radiance);
   const float sun_radius = radians(1.6f);  // a little over a texel at 256 x 128, like a small sun
