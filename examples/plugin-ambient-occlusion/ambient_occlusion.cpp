@@ -21,8 +21,12 @@ class AmbientOcclusion final : public PixelIntegrator {
  public:
   AmbientOcclusion(bool cos_sample, float max_distance) : cos_sample_(cos_sample), max_distance_(max_distance) {}
 
-  Rgb Li(const Ray& ray, const SampledWavelengths*, Sampler& sampler, const Scene& scene) const override {
-    std::optional<SurfaceInteraction> si = scene.intersect(ray);
+  // The loop traces the camera rays of neighbouring pixels as one packet and hands each its hit.
+  bool takes_first_hit() const override { return true; }
+
+  Rgb Li(const Ray& ray, const std::optional<SurfaceInteraction>* first_hit, const SampledWavelengths*,
+         Sampler& sampler, const Scene& scene) const override {
+    std::optional<SurfaceInteraction> si = first_hit ? *first_hit : scene.intersect(ray);
     Vec2 u = sampler.get_2d();  // drawn for misses too, so every sample uses the same dimensions
     if (!si) return Rgb(0.f);
 

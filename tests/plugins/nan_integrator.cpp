@@ -11,7 +11,8 @@ using namespace penumbra;
 
 class NanIntegrator final : public PixelIntegrator {
  public:
-  Rgb Li(const Ray&, const SampledWavelengths*, Sampler& sampler, const Scene&) const override {
+  Rgb Li(const Ray&, const std::optional<SurfaceInteraction>*, const SampledWavelengths*, Sampler& sampler,
+         const Scene&) const override {
     float u = sampler.get_1d();
     if (u < 0.1f) return Rgb(std::numeric_limits<float>::quiet_NaN());
     if (u < 0.2f) return Rgb(std::numeric_limits<float>::infinity(), 0.f, 0.f);

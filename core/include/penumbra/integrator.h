@@ -137,6 +137,11 @@ struct PixelSample {
   /// the pass's: see wavelengths_per_pass()): sample() then returns, and splats, values at these
   /// wavelengths, which the loop turns into RGB. Null in an RGB render.
   const SampledWavelengths* wavelengths = nullptr;
+  /// The camera ray's first hit (what scene.intersect(*ray) returns), when the render loop traced
+  /// it: the loop traces the camera rays of a block of neighbouring pixels as one packet, several
+  /// times faster than one at a time, for pixel integrators that ask (PixelIntegrator's
+  /// takes_first_hit()). Null otherwise.
+  const std::optional<SurfaceInteraction>* first_hit = nullptr;
 };
 
 /// A run of sample indices [first_index, first_index + count) rendered for every pixel.
@@ -207,12 +212,16 @@ class PixelIntegrator : public SampleIntegrator {
  public:
   ~PixelIntegrator() override;
   Rgb sample(const Scene& scene, const PixelSample& ps, Sampler& sampler, SplatSink& splats) final {
-    return ps.ray ? Li(*ps.ray, ps.wavelengths, sampler, scene) : Rgb(0.f);
+    return ps.ray ? Li(*ps.ray, ps.first_hit, ps.wavelengths, sampler, scene) : Rgb(0.f);
   }
   /// Radiance arriving along the camera ray: RGB, or in a spectral render (`wavelengths` not null)
-  /// its values at the wavelengths. Draw random numbers only from `sampler`.
-  virtual Rgb Li(const Ray& ray, const SampledWavelengths* wavelengths, Sampler& sampler,
-                 const Scene& scene) const = 0;
+  /// its values at the wavelengths. Draw random numbers only from `sampler`. `first_hit` is null,
+  /// or scene.intersect(ray) traced by the loop (only when takes_first_hit() says so): use it
+  /// instead of tracing the camera ray again.
+  virtual Rgb Li(const Ray& ray, const std::optional<SurfaceInteraction>* first_hit,
+                 const SampledWavelengths* wavelengths, Sampler& sampler, const Scene& scene) const = 0;
+  /// True when Li() starts by tracing the camera ray: the loop then traces it, in packets.
+  virtual bool takes_first_hit() const { return false; }
 };
 
 }  // namespace penumbra

@@ -25,7 +25,8 @@
 //     SampleIntegrator::supports_spectral(), ParamSet::set_bool.
 // 12: SampleIntegrator::wavelengths_per_pass(), Pass::wavelengths.
 // 13: CameraWiSample::pdf_pos and pdf_dir.
-#define PENUMBRA_SDK_VERSION 13
+// 14: PixelSample::first_hit; PixelIntegrator::Li() takes it, takes_first_hit().
+#define PENUMBRA_SDK_VERSION 14
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

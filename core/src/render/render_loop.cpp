@@ -7,6 +7,7 @@
 #include "image/splat_buffers.h"
 #include "render/checkpoint.h"
 #include "render/surface_sample.h"
+#include "scene/embree_scene.h"
 
 #include <penumbra/integrator.h>
 #include <penumbra/memory.h>
@@ -51,9 +52,24 @@ class CheckedSplats final : public SplatSink {
   const SampledWavelengths* wavelengths_ = nullptr;
 };
 
+// Pixel integrators whose Li() starts by tracing the camera ray get it traced by the loop, as one
+// Embree packet per block of 4x2 pixels at one sample index (EmbreeScene::intersect_coherent()).
+// The block is a fixed set of pixels (tiles are 16x16 and start at multiples of 16), so a pixel's
+// packet does not depend on passes, threads or split renders.
+constexpr int kBlockWidth = 4, kBlockHeight = 2, kMaxLanes = kBlockWidth * kBlockHeight;
+
 struct ThreadState {
-  std::unique_ptr<Sampler> sampler;
+  std::vector<std::unique_ptr<Sampler>> samplers;  // one per pixel of a block
   CheckedSplats splats;
+};
+
+// One pixel sample of a block between the camera and the integrator.
+struct Lane {
+  Point2i pixel;
+  PixelSample ps;
+  FilterSample fs;
+  std::optional<Ray> ray;
+  SampledWavelengths wavelengths;
 };
 
 // Per-pass wavelengths: the base-2 radical inverse of the pass's first sample index, rotated (mod 1)
@@ -106,8 +122,15 @@ void SampleIntegrator::render(RenderContext& ctx) {
                    fmt::format("{}x{} pixels, 48 bytes each in 2 MiB chunks, for each of {} threads", res.x, res.y, threads));
   }
 
-  tbb::enumerable_thread_specific<ThreadState> threads(
-      [&] { return ThreadState{ctx.sampler().clone(), CheckedSplats(ctx, film)}; });
+  const auto* pixel_integrator = dynamic_cast<const PixelIntegrator*>(this);
+  const EmbreeScene* packets = pixel_integrator && pixel_integrator->takes_first_hit()
+                                   ? dynamic_cast<const EmbreeScene*>(&scene) : nullptr;
+  const int block_w = packets ? kBlockWidth : 1, block_h = packets ? kBlockHeight : 1;
+  tbb::enumerable_thread_specific<ThreadState> threads([&] {
+    ThreadState ts{{}, CheckedSplats(ctx, film)};
+    for (int k = 0; k < block_w * block_h; ++k) ts.samplers.push_back(ctx.sampler().clone());
+    return ts;
+  });
 
   // What the runtime learns after each pass: whole passes done, what the splats are divided by (the
   // pixel samples actually taken over the pixel count) and, when the film does not hold it, where
@@ -136,7 +159,6 @@ void SampleIntegrator::render(RenderContext& ctx) {
     std::atomic<bool> cut{false};
     tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
       ThreadState& ts = threads.local();
-      Sampler& sampler = *ts.sampler;
       for (int tile = r.begin(); tile < r.end(); ++tile) {
         if (ctx.should_stop()) {
           cut.store(true, std::memory_order_relaxed);
@@ -144,40 +166,61 @@ void SampleIntegrator::render(RenderContext& ctx) {
         }
         int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
         int x1 = std::min(x0 + kTileSize, res.x), y1 = std::min(y0 + kTileSize, res.y);
-        for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x) {
-            Point2i pixel(x, y);
-            ts.splats.start(pixel);
+        for (int by = y0; by < y1; by += block_h)
+          for (int bx = x0; bx < x1; bx += block_w) {
+            Lane lanes[kMaxLanes];
+            int n = 0;
+            for (int y = by; y < std::min(by + block_h, y1); ++y)
+              for (int x = bx; x < std::min(bx + block_w, x1); ++x) lanes[n++].pixel = Point2i(x, y);
+            // Each pixel's samples in index order; the pixels of a block take turns.
             for (int s = 0; s < pass.count; ++s) {
               uint32_t index = pass.first_index + static_cast<uint32_t>(s);
-              sampler.start_pixel_sample(pixel, index);
-              FilterSample fs = film.sample_filter(sampler.get_pixel_2d());
-              PixelSample ps;
-              ps.pixel = pixel;
-              ps.index = index;
-              ps.camera = CameraSample{Vec2(x + 0.5f, y + 0.5f) + fs.offset, sampler.get_2d()};
-              std::optional<Ray> ray = camera.generate_ray(ps.camera);
-              ps.ray = ray ? &*ray : nullptr;
-              SampledWavelengths wavelengths;
-              if (spectral) {
-                // Drawn in either case, so the sampler's dimensions do not depend on the choice.
-                float u = sampler.get_1d();
-                if (per_pass_wavelengths) wavelengths = pass_wavelengths;
-                else wavelengths = SampledWavelengths::sample(u);
-                ps.wavelengths = &wavelengths;
-                ts.splats.set_wavelengths(&wavelengths);
+              for (int k = 0; k < n; ++k) {
+                Lane& lane = lanes[k];
+                Sampler& sampler = *ts.samplers[k];
+                sampler.start_pixel_sample(lane.pixel, index);
+                lane.fs = film.sample_filter(sampler.get_pixel_2d());
+                PixelSample& ps = lane.ps;
+                ps = PixelSample{};
+                ps.pixel = lane.pixel;
+                ps.index = index;
+                ps.camera = CameraSample{Vec2(lane.pixel) + Vec2(0.5f) + lane.fs.offset, sampler.get_2d()};
+                lane.ray = camera.generate_ray(ps.camera);
+                ps.ray = lane.ray ? &*lane.ray : nullptr;
+                if (spectral) {
+                  // Drawn in either case, so the sampler's dimensions do not depend on the choice.
+                  float u = sampler.get_1d();
+                  if (per_pass_wavelengths) lane.wavelengths = pass_wavelengths;
+                  else lane.wavelengths = SampledWavelengths::sample(u);
+                  ps.wavelengths = &lane.wavelengths;
+                }
               }
-              Rgb L = sample(scene, ps, sampler, ts.splats);
-              if (spectral) L = wavelengths.to_rgb(L);
-              if (surface_aovs)
-                film.add_surface_sample(pixel, ray ? trace_surface_sample(scene, *ray, pixel, index) : SurfaceSample{},
-                                        fs.weight);
-              if (!to_film) continue;
-              if (!is_finite(L)) {
-                ctx.report_nonfinite(pixel);
-                continue;
+              std::optional<SurfaceInteraction> hits[kMaxLanes];
+              if (packets) {
+                const Ray* rays[kMaxLanes];
+                for (int k = 0; k < n; ++k) {
+                  rays[k] = lanes[k].ps.ray;
+                  lanes[k].ps.first_hit = &hits[k];
+                }
+                packets->intersect_coherent(std::span<const Ray* const>(rays, n), hits);
               }
-              film.add_sample(pixel, L, fs.weight);
+              for (int k = 0; k < n; ++k) {
+                Lane& lane = lanes[k];
+                ts.splats.start(lane.pixel);
+                if (spectral) ts.splats.set_wavelengths(&lane.wavelengths);
+                Rgb L = sample(scene, lane.ps, *ts.samplers[k], ts.splats);
+                if (spectral) L = lane.wavelengths.to_rgb(L);
+                if (surface_aovs)
+                  film.add_surface_sample(lane.pixel, lane.ray ? trace_surface_sample(scene, *lane.ray, lane.pixel, index)
+                                                               : SurfaceSample{},
+                                          lane.fs.weight);
+                if (!to_film) continue;
+                if (!is_finite(L)) {
+                  ctx.report_nonfinite(lane.pixel);
+                  continue;
+                }
+                film.add_sample(lane.pixel, L, lane.fs.weight);
+              }
             }
           }
         uint64_t n = static_cast<uint64_t>(x1 - x0) * (y1 - y0) * pass.count;

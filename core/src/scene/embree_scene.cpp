@@ -107,27 +107,40 @@ static std::optional<float> first_kept_hit(const GeometryUserData& data, const R
   return std::nullopt;
 }
 
+// Embree hands user geometry one ray (rtcIntersect1) or a packet of N (the render loop's camera
+// rays, rtcIntersect8): each active lane is answered as a single ray would be.
 static void user_intersect(const RTCIntersectFunctionNArguments* args) {
-  if (args->N != 1 || !args->valid[0]) return;
-  auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
-  Ray ray{Vec3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z), Vec3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z)};
-  auto t = first_kept_hit(*static_cast<const GeometryUserData*>(args->geometryUserPtr), ray, rh->ray.tnear,
-                          rh->ray.tfar, args->geomID);
-  if (!t) return;
-  rh->ray.tfar = *t;
-  rh->hit.geomID = args->geomID;
-  rh->hit.primID = args->primID;
-  rh->hit.u = rh->hit.v = 0.f;
-  rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0.f;  // the surface is rebuilt from t in intersect()
-  rh->hit.instID[0] = args->context->instID[0];
+  const auto& data = *static_cast<const GeometryUserData*>(args->geometryUserPtr);
+  const unsigned N = args->N;
+  RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, N);
+  RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, N);
+  for (unsigned i = 0; i < N; ++i) {
+    if (args->valid[i] != -1) continue;
+    Ray ray{Vec3(RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)),
+            Vec3(RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i))};
+    auto t = first_kept_hit(data, ray, RTCRayN_tnear(rays, N, i), RTCRayN_tfar(rays, N, i), args->geomID);
+    if (!t) continue;
+    RTCRayN_tfar(rays, N, i) = *t;
+    RTCHitN_geomID(hits, N, i) = args->geomID;
+    RTCHitN_primID(hits, N, i) = args->primID;
+    RTCHitN_u(hits, N, i) = RTCHitN_v(hits, N, i) = 0.f;
+    // The surface is rebuilt from t in fill_hit().
+    RTCHitN_Ng_x(hits, N, i) = RTCHitN_Ng_y(hits, N, i) = RTCHitN_Ng_z(hits, N, i) = 0.f;
+    RTCHitN_instID(hits, N, i, 0) = args->context->instID[0];
+  }
 }
 
 static void user_occluded(const RTCOccludedFunctionNArguments* args) {
-  if (args->N != 1 || !args->valid[0]) return;
-  auto* r = reinterpret_cast<RTCRay*>(args->ray);
-  Ray ray{Vec3(r->org_x, r->org_y, r->org_z), Vec3(r->dir_x, r->dir_y, r->dir_z)};
-  if (first_kept_hit(*static_cast<const GeometryUserData*>(args->geometryUserPtr), ray, r->tnear, r->tfar, args->geomID))
-    r->tfar = -INFINITY;
+  const auto& data = *static_cast<const GeometryUserData*>(args->geometryUserPtr);
+  const unsigned N = args->N;
+  for (unsigned i = 0; i < N; ++i) {
+    if (args->valid[i] != -1) continue;
+    RTCRayN* r = args->ray;
+    Ray ray{Vec3(RTCRayN_org_x(r, N, i), RTCRayN_org_y(r, N, i), RTCRayN_org_z(r, N, i)),
+            Vec3(RTCRayN_dir_x(r, N, i), RTCRayN_dir_y(r, N, i), RTCRayN_dir_z(r, N, i))};
+    if (first_kept_hit(data, ray, RTCRayN_tnear(r, N, i), RTCRayN_tfar(r, N, i), args->geomID))
+      RTCRayN_tfar(r, N, i) = -INFINITY;
+  }
 }
 
 RTCGeometry EmbreeScene::new_user_geometry(const GeometryUserData& data) {
@@ -325,35 +338,83 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   float t_scale, t_shift;
   RTCRayHit rh = embree_ray(ray, &t_scale, &t_shift);
   rtcIntersect1(scene_, &ctx, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  std::optional<SurfaceInteraction> out;  // filled where the caller receives it (no copy out)
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return out;
   if (has_curves_) rh.ray.tfar = (rh.ray.tfar - t_shift) / t_scale;
+  fill_hit(ray, rh.ray.tfar, rh.hit, out.emplace());
+  return out;
+}
 
+void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::optional<SurfaceInteraction>* hits) const {
+  if (has_curves_ || rays.size() > 8) {  // curves move each ray's origin (embree_ray()): one at a time
+    for (size_t i = 0; i < rays.size(); ++i) {
+      if (rays[i]) hits[i] = intersect(*rays[i]);
+      else hits[i].reset();
+    }
+    return;
+  }
+  alignas(32) int valid[8];
+  alignas(32) RTCRayHit8 rh;
+  for (int i = 0; i < 8; ++i) {
+    const Ray* r = i < static_cast<int>(rays.size()) ? rays[i] : nullptr;
+    valid[i] = r ? -1 : 0;
+    Vec3 o = r ? r->o : Vec3(0.f), d = r ? r->d : Vec3(0.f, 0.f, 1.f);
+    rh.ray.org_x[i] = o.x, rh.ray.org_y[i] = o.y, rh.ray.org_z[i] = o.z;
+    rh.ray.dir_x[i] = d.x, rh.ray.dir_y[i] = d.y, rh.ray.dir_z[i] = d.z;
+    rh.ray.tnear[i] = 0.f;
+    rh.ray.tfar[i] = r ? r->tmax : -Infinity;
+    rh.ray.time[i] = 0.f;
+    rh.ray.mask[i] = 0xFFFFFFFFu;
+    rh.ray.id[i] = 0;
+    rh.ray.flags[i] = 0;
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect8(valid, scene_, &ctx, &rh);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    hits[i].reset();
+    if (!rays[i]) continue;
+    count_ray();
+    if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+    RTCHit h;
+    h.Ng_x = rh.hit.Ng_x[i], h.Ng_y = rh.hit.Ng_y[i], h.Ng_z = rh.hit.Ng_z[i];
+    h.u = rh.hit.u[i], h.v = rh.hit.v[i];
+    h.primID = rh.hit.primID[i], h.geomID = rh.hit.geomID[i];
+    h.instID[0] = rh.hit.instID[0][i];
+    fill_hit(*rays[i], rh.ray.tfar[i], h, hits[i].emplace());
+  }
+}
+
+// The surface at a hit Embree reported at distance t along `ray` (in the ray's own units).
+void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const {
   // A hit inside an instance is computed in the prototype's space and then placed.
-  const Instance* inst = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[rh.hit.instID[0]] : nullptr;
-  const Geometry& g = inst ? prototypes_[inst->prototype].geometries[rh.hit.geomID] : geometries_[rh.hit.geomID];
+  const Instance* inst = hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[hit.instID[0]] : nullptr;
+  const Geometry& g = inst ? prototypes_[inst->prototype].geometries[hit.geomID] : geometries_[hit.geomID];
   Ray local = inst ? Ray{Vec3(inst->to_object * Vec4(ray.o, 1.f)), glm::mat3(inst->to_object) * ray.d, ray.tmax} : ray;
-  SurfaceInteraction si;
-  si.t = rh.ray.tfar;
+  si.t = t;
   si.wo = -glm::normalize(ray.d);
-  si.shape_id = inst ? rh.hit.instID[0] : rh.hit.geomID;
-  si.prim_id = rh.hit.primID;
+  si.shape_id = inst ? hit.instID[0] : hit.geomID;
+  si.prim_id = hit.primID;
   si.bsdf = g.bsdf;
   si.media = g.media;
-  if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? rh.hit.primID : 0];
+  if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? hit.primID : 0];
   Vec3 dpdu(0.f), dpdv(0.f);  // for tangent frames and texture footprints only
   if (g.mesh) {
     // The hit point comes from the barycentrics: its error does not grow with t.
-    Vec3 b(1.f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v);
-    TriangleMesh::Surface s = g.mesh->surface(rh.hit.primID, b);
+    Vec3 b(1.f - hit.u - hit.v, hit.u, hit.v);
+    TriangleMesh::Surface s = g.mesh->surface(hit.primID, b);
     si.p = s.p;
     si.p_error = s.p_error;
     si.ng = s.ng;
     si.ns = s.ns;
     si.uv = s.uv;
-    if (g.tangent_frame) g.mesh->uv_derivatives(rh.hit.primID, &dpdu, &dpdv);
+    if (g.tangent_frame) g.mesh->uv_derivatives(hit.primID, &dpdu, &dpdv);
   } else if (g.curves) {
-    Curves::Surface s = g.curves->surface(rh.hit.primID, rh.hit.u, rh.hit.v, local.o + si.t * local.d,
-                                          glm::normalize(local.d), Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+    Curves::Surface s = g.curves->surface(hit.primID, hit.u, hit.v, local.o + si.t * local.d,
+                                          glm::normalize(local.d), Vec3(hit.Ng_x, hit.Ng_y, hit.Ng_z));
     dpdu = s.dpdu;
     dpdv = s.dpdv;
     si.p = s.p;
@@ -383,14 +444,13 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   }
   if (!g.tangent_frame) {
     si.shading = Frame(si.ns);
-    return si;
+    return;
   }
   // The shading frame follows dp/du (pbrt-v4's BSDF frame), so anisotropic lobes and normal maps are
   // oriented by the parameterisation.
   si.shading = tangent_frame(si.ns, dpdu);
   if (g.textured) add_texture_footprint(si, dpdu, dpdv);
   if (g.detail.any()) apply_surface_detail(g.detail, shading_geometry(g, si, dpdu, dpdv), si);
-  return si;
 }
 
 // Point, normals and the error bound from the prototype's space to the world, as pbrt-v4 transforms

@@ -78,6 +78,12 @@ class EmbreeScene final : public Scene {
 
   std::optional<SurfaceInteraction> intersect(const Ray& ray) const override;
   bool occluded(const Ray& ray) const override;
+  /// intersect() of up to 8 rays at once, as one packet (Embree's rtcIntersect8, coherent): for
+  /// rays that start together and diverge little, such as the camera rays of neighbouring pixels.
+  /// A null ray gets no hit. The render loop gives each packet a fixed set of rays (a pixel block at
+  /// one sample index), because where two triangles share an edge, which one a ray reports can
+  /// depend on the other rays of its packet.
+  void intersect_coherent(std::span<const Ray* const> rays, std::optional<SurfaceInteraction>* hits) const;
   std::span<const Light* const> lights() const override { return lights_; }
   std::span<const Light* const> infinite_lights() const override { return infinite_; }
   std::optional<SampledLight> sample_light(float u) const override;
@@ -118,6 +124,7 @@ class EmbreeScene final : public Scene {
   Bounds3& target_bounds() { return target_ < 0 ? bounds_ : prototypes_[target_].bounds; }
   void place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const;
   RTCRayHit embree_ray(const Ray& ray, float* t_scale, float* t_shift) const;
+  void fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const;
   void attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
               const SurfaceOptions& options);
   void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;

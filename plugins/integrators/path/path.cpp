@@ -31,8 +31,10 @@ class PathIntegrator final : public PixelIntegrator {
 
   bool supports_spectral() const override { return true; }
 
-  Rgb Li(const Ray& camera_ray, const SampledWavelengths* wavelengths, Sampler& sampler,
-         const Scene& scene) const override {
+  bool takes_first_hit() const override { return true; }
+
+  Rgb Li(const Ray& camera_ray, const std::optional<SurfaceInteraction>* first_hit,
+         const SampledWavelengths* wavelengths, Sampler& sampler, const Scene& scene) const override {
     Rgb L(0.f), beta(1.f);
     Ray ray = camera_ray;
     bool specular_bounce = false;
@@ -43,7 +45,7 @@ class PathIntegrator final : public PixelIntegrator {
     const bool media = scene.has_media();
 
     for (int depth = 0;; ++depth) {
-      std::optional<SurfaceInteraction> si = scene.intersect(ray);
+      std::optional<SurfaceInteraction> si = depth == 0 && first_hit ? *first_hit : scene.intersect(ray);
       if (media) {  // absorption along the segment just traced
         medium = segment_medium(medium, si ? si->media.toward(si->ng, -ray.d) : kMediumUnknown);
         beta *= scene.transmittance(medium, si ? si->t * glm::length(ray.d) : Infinity, wavelengths);
