@@ -3,7 +3,8 @@
 // time and every sample is a pure function of (pixel, index, seed), so the image is the same bit for
 // bit whatever the thread count, and a part of a split render (indices [first_sample, first_sample +
 // spp)) takes exactly its share of them. Splats go to the film's per-thread fixed-point buffers,
-// whose integer sums do not depend on the order of the additions.
+// whose integer sums do not depend on the order of the additions. Pixel integrators that take their
+// camera ray's first hit are walked in 4x2-pixel blocks whose camera rays are traced as one packet.
 #include "image/splat_buffers.h"
 #include "render/checkpoint.h"
 #include "render/surface_sample.h"
