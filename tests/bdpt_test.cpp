@@ -355,21 +355,22 @@ test::SeedMean render_over_seeds(const std::string& file, const std::string& int
 
 double green_mean(const ImageRgb& image) { return test::mean_channel(image, 1); }
 
-std::string furnace_scene(float albedo, int maxdepth, const std::string& integrator) {
+std::string furnace_scene(float albedo, int maxdepth, const std::string& integrator,
+                          const std::string& integrator_params = "") {
   return fmt::format(R"(
 LookAt 0 0 0  0 0 1  0 1 0
 Camera "perspective" "float fov" [ 60 ]
 Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
 PixelFilter "box"
 Sampler "independent" "integer pixelsamples" [ 64 ]
-Integrator "{}" "integer maxdepth" [ {} ]
+Integrator "{}" "integer maxdepth" [ {} ] {}
 WorldBegin
 Material "diffuse" "rgb reflectance" [ {} {} {} ]
 AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
 ReverseOrientation
 Shape "sphere" "float radius" [ 1 ]
 )",
-                     integrator, maxdepth, albedo, albedo, albedo);
+                     integrator, maxdepth, integrator_params, albedo, albedo, albedo);
 }
 
 const std::string kCornellDir = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box";
@@ -461,7 +462,8 @@ TEST(BdptMis, WeightsMatchBruteForceUnderAnEnvironmentAndADistantLight) {
 // their spread) of 2, and that tolerance below 1 % of 2, so a 1 % bias would fail.
 TEST(Bdpt, FurnaceSphereRendersLeOverOneMinusAlbedo) {
   const int runs = 8;
-  for (auto [integrator, spp] : {std::pair{"bdpt", 8}, std::pair{"lighttracing", 512}}) {
+  // bdpt at 16 spp: with its roulette from the first bounce, 8 spp left 4 standard errors at 1.26 %.
+  for (auto [integrator, spp] : {std::pair{"bdpt", 16}, std::pair{"lighttracing", 512}}) {
     std::string file = write_scene(std::string("furnace-") + integrator, furnace_scene(0.5f, 200, integrator));
     auto [mean, se] = render_over_seeds(file, "", spp, 16, 16, runs, green_mean);
     double tol = 4.0 * se + 1e-6;
@@ -485,7 +487,10 @@ TEST(Bdpt, MaxDepthTruncatesSeriesExactly) {
   const int runs = 8;
   for (auto [integrator, spp] : {std::pair{"bdpt", 16}, std::pair{"lighttracing", 1024}})
     for (int depth : {0, 1, 2, 5}) {
-      std::string file = write_scene(fmt::format("series-{}-{}", integrator, depth), furnace_scene(a, depth, integrator));
+      // Russian roulette from the third bounce (bdpt's default is the first): the series' last terms
+      // (0.5^6 = 0.016 between maxdepth 5 and 6) must stand out of the noise of 16 spp x 8 seeds.
+      std::string file = write_scene(fmt::format("series-{}-{}", integrator, depth),
+                                     furnace_scene(a, depth, integrator, "\"integer rrdepth\" [ 3 ]"));
       auto [mean, se] = render_over_seeds(file, "", spp, 16, 16, runs, green_mean);
       double tol = 4.0 * se + 1e-6;
       EXPECT_NEAR(mean, series(depth), tol) << integrator << " maxdepth " << depth;

@@ -15,7 +15,7 @@
 // | parameter                | default | meaning                                                |
 // |--------------------------|---------|--------------------------------------------------------|
 // | integer maxdepth         | 5       | longest path in bounces (pbrt's convention, as "path") |
-// | integer rrdepth          | 3       | bounces of a subpath before Russian roulette           |
+// | integer rrdepth          | 1       | bounces of a subpath before Russian roulette           |
 // | string lightsampler      | power   | light choice: power or uniform                         |
 // | string misheuristic      | balance | balance or power (beta = 2); docs/bdpt.md: why balance |
 // | bool visualizestrategies | false   | write each strategy's contribution, weighted and not   |
@@ -317,7 +317,7 @@ class BdptIntegrator final : public SampleIntegrator {
 
 const ParamSpec kParams[] = {
     {"integer", "maxdepth", "5", "longest path in bounces"},
-    {"integer", "rrdepth", "3", "bounces of a subpath before Russian roulette may end it"},
+    {"integer", "rrdepth", "1", "bounces of a subpath before Russian roulette may end it"},
     {"string", "lightsampler", "power", "light selection: power or uniform"},
     {"string", "misheuristic", "balance", "MIS heuristic: balance or power"},
     {"bool", "visualizestrategies", "false", "write each strategy's contribution (weighted and unweighted)"},
