@@ -73,6 +73,27 @@ struct Lane {
   SampledWavelengths wavelengths;
 };
 
+// Starts the lane's pixel sample at `index`: the film position, the lens position and the camera ray,
+// and in a spectral render the wavelengths, in that order of the sampler's dimensions.
+void start_lane(Lane& lane, Sampler& sampler, uint32_t index, const Film& film, const Camera& camera, bool spectral,
+                const SampledWavelengths* pass_wavelengths) {
+  sampler.start_pixel_sample(lane.pixel, index);
+  lane.fs = film.sample_filter(sampler.get_pixel_2d());
+  PixelSample& ps = lane.ps;
+  ps = PixelSample{};
+  ps.pixel = lane.pixel;
+  ps.index = index;
+  ps.camera = CameraSample{Vec2(lane.pixel) + Vec2(0.5f) + lane.fs.offset, sampler.get_2d()};
+  lane.ray = camera.generate_ray(ps.camera);
+  ps.ray = lane.ray ? &*lane.ray : nullptr;
+  if (spectral) {
+    // Drawn in either case, so the sampler's dimensions do not depend on the choice.
+    float u = sampler.get_1d();
+    lane.wavelengths = pass_wavelengths ? *pass_wavelengths : SampledWavelengths::sample(u);
+    ps.wavelengths = &lane.wavelengths;
+  }
+}
+
 // Per-pass wavelengths: the base-2 radical inverse of the pass's first sample index, rotated (mod 1)
 // by a number that follows the seed, so that passes stratify the spectrum and seeds differ.
 float pass_wavelength_number(uint32_t first_index, float rotation) {
@@ -176,26 +197,8 @@ void SampleIntegrator::render(RenderContext& ctx) {
             // Each pixel's samples in index order; the pixels of a block take turns.
             for (int s = 0; s < pass.count; ++s) {
               uint32_t index = pass.first_index + static_cast<uint32_t>(s);
-              for (int k = 0; k < n; ++k) {
-                Lane& lane = lanes[k];
-                Sampler& sampler = *ts.samplers[k];
-                sampler.start_pixel_sample(lane.pixel, index);
-                lane.fs = film.sample_filter(sampler.get_pixel_2d());
-                PixelSample& ps = lane.ps;
-                ps = PixelSample{};
-                ps.pixel = lane.pixel;
-                ps.index = index;
-                ps.camera = CameraSample{Vec2(lane.pixel) + Vec2(0.5f) + lane.fs.offset, sampler.get_2d()};
-                lane.ray = camera.generate_ray(ps.camera);
-                ps.ray = lane.ray ? &*lane.ray : nullptr;
-                if (spectral) {
-                  // Drawn in either case, so the sampler's dimensions do not depend on the choice.
-                  float u = sampler.get_1d();
-                  if (per_pass_wavelengths) lane.wavelengths = pass_wavelengths;
-                  else lane.wavelengths = SampledWavelengths::sample(u);
-                  ps.wavelengths = &lane.wavelengths;
-                }
-              }
+              for (int k = 0; k < n; ++k)
+                start_lane(lanes[k], *ts.samplers[k], index, film, camera, spectral, pass.wavelengths);
               std::optional<SurfaceInteraction> hits[kMaxLanes];
               if (packets) {
                 const Ray* rays[kMaxLanes];
