@@ -107,26 +107,29 @@ static std::optional<float> first_kept_hit(const GeometryUserData& data, const R
   return std::nullopt;
 }
 
+// Lane i of a ray packet of width N (N = 1 for rtcIntersect1 and rtcOccluded1).
+static Ray lane_ray(RTCRayN* rays, unsigned N, unsigned i) {
+  return Ray{Vec3(RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)),
+             Vec3(RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i))};
+}
+
 // Embree hands user geometry one ray (rtcIntersect1) or a packet of N (the render loop's camera
 // rays, rtcIntersect8): each active lane is answered as a single ray would be.
 static void user_intersect(const RTCIntersectFunctionNArguments* args) {
   const auto& data = *static_cast<const GeometryUserData*>(args->geometryUserPtr);
   const unsigned N = args->N;
   RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, N);
-  RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, N);
   for (unsigned i = 0; i < N; ++i) {
     if (args->valid[i] != -1) continue;
-    Ray ray{Vec3(RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)),
-            Vec3(RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i))};
-    auto t = first_kept_hit(data, ray, RTCRayN_tnear(rays, N, i), RTCRayN_tfar(rays, N, i), args->geomID);
+    auto t = first_kept_hit(data, lane_ray(rays, N, i), RTCRayN_tnear(rays, N, i), RTCRayN_tfar(rays, N, i),
+                            args->geomID);
     if (!t) continue;
     RTCRayN_tfar(rays, N, i) = *t;
-    RTCHitN_geomID(hits, N, i) = args->geomID;
-    RTCHitN_primID(hits, N, i) = args->primID;
-    RTCHitN_u(hits, N, i) = RTCHitN_v(hits, N, i) = 0.f;
-    // The surface is rebuilt from t in fill_hit().
-    RTCHitN_Ng_x(hits, N, i) = RTCHitN_Ng_y(hits, N, i) = RTCHitN_Ng_z(hits, N, i) = 0.f;
-    RTCHitN_instID(hits, N, i, 0) = args->context->instID[0];
+    RTCHit hit{};  // u, v and Ng stay 0: the surface is rebuilt from t in fill_hit()
+    hit.geomID = args->geomID;
+    hit.primID = args->primID;
+    hit.instID[0] = args->context->instID[0];
+    rtcCopyHitToHitN(RTCRayHitN_HitN(args->rayhit, N), &hit, N, i);
   }
 }
 
@@ -135,11 +138,9 @@ static void user_occluded(const RTCOccludedFunctionNArguments* args) {
   const unsigned N = args->N;
   for (unsigned i = 0; i < N; ++i) {
     if (args->valid[i] != -1) continue;
-    RTCRayN* r = args->ray;
-    Ray ray{Vec3(RTCRayN_org_x(r, N, i), RTCRayN_org_y(r, N, i), RTCRayN_org_z(r, N, i)),
-            Vec3(RTCRayN_dir_x(r, N, i), RTCRayN_dir_y(r, N, i), RTCRayN_dir_z(r, N, i))};
-    if (first_kept_hit(data, ray, RTCRayN_tnear(r, N, i), RTCRayN_tfar(r, N, i), args->geomID))
-      RTCRayN_tfar(r, N, i) = -INFINITY;
+    if (first_kept_hit(data, lane_ray(args->ray, N, i), RTCRayN_tnear(args->ray, N, i), RTCRayN_tfar(args->ray, N, i),
+                       args->geomID))
+      RTCRayN_tfar(args->ray, N, i) = -INFINITY;
   }
 }
 
@@ -353,38 +354,34 @@ void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::opti
     }
     return;
   }
+  // Each lane is the ray intersect() would trace (make_rayhit()); empty lanes are masked off.
   alignas(32) int valid[8];
-  alignas(32) RTCRayHit8 rh;
-  for (int i = 0; i < 8; ++i) {
-    const Ray* r = i < static_cast<int>(rays.size()) ? rays[i] : nullptr;
+  alignas(32) RTCRayHit8 packet;
+  RTCRayN* lanes = RTCRayHitN_RayN(reinterpret_cast<RTCRayHitN*>(&packet), 8);
+  RTCHitN* lane_hits = RTCRayHitN_HitN(reinterpret_cast<RTCRayHitN*>(&packet), 8);
+  for (unsigned i = 0; i < 8; ++i) {
+    const Ray* r = i < rays.size() ? rays[i] : nullptr;
     valid[i] = r ? -1 : 0;
-    Vec3 o = r ? r->o : Vec3(0.f), d = r ? r->d : Vec3(0.f, 0.f, 1.f);
-    rh.ray.org_x[i] = o.x, rh.ray.org_y[i] = o.y, rh.ray.org_z[i] = o.z;
-    rh.ray.dir_x[i] = d.x, rh.ray.dir_y[i] = d.y, rh.ray.dir_z[i] = d.z;
-    rh.ray.tnear[i] = 0.f;
-    rh.ray.tfar[i] = r ? r->tmax : -Infinity;
-    rh.ray.time[i] = 0.f;
-    rh.ray.mask[i] = 0xFFFFFFFFu;
-    rh.ray.id[i] = 0;
-    rh.ray.flags[i] = 0;
-    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit one = make_rayhit(r ? *r : Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f), -Infinity});
+    RTCRayN_org_x(lanes, 8, i) = one.ray.org_x, RTCRayN_org_y(lanes, 8, i) = one.ray.org_y;
+    RTCRayN_org_z(lanes, 8, i) = one.ray.org_z, RTCRayN_tnear(lanes, 8, i) = one.ray.tnear;
+    RTCRayN_dir_x(lanes, 8, i) = one.ray.dir_x, RTCRayN_dir_y(lanes, 8, i) = one.ray.dir_y;
+    RTCRayN_dir_z(lanes, 8, i) = one.ray.dir_z, RTCRayN_time(lanes, 8, i) = one.ray.time;
+    RTCRayN_tfar(lanes, 8, i) = one.ray.tfar, RTCRayN_mask(lanes, 8, i) = one.ray.mask;
+    RTCRayN_id(lanes, 8, i) = one.ray.id, RTCRayN_flags(lanes, 8, i) = one.ray.flags;
+    RTCHitN_geomID(lane_hits, 8, i) = one.hit.geomID;
+    RTCHitN_instID(lane_hits, 8, i, 0) = one.hit.instID[0];
   }
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  rtcIntersect8(valid, scene_, &ctx, &rh);
+  rtcIntersect8(valid, scene_, &ctx, &packet);
   for (size_t i = 0; i < rays.size(); ++i) {
     hits[i].reset();
     if (!rays[i]) continue;
     count_ray();
-    if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-    RTCHit h;
-    h.Ng_x = rh.hit.Ng_x[i], h.Ng_y = rh.hit.Ng_y[i], h.Ng_z = rh.hit.Ng_z[i];
-    h.u = rh.hit.u[i], h.v = rh.hit.v[i];
-    h.primID = rh.hit.primID[i], h.geomID = rh.hit.geomID[i];
-    h.instID[0] = rh.hit.instID[0][i];
-    fill_hit(*rays[i], rh.ray.tfar[i], h, hits[i].emplace());
+    if (RTCHitN_geomID(lane_hits, 8, i) == RTC_INVALID_GEOMETRY_ID) continue;
+    fill_hit(*rays[i], RTCRayN_tfar(lanes, 8, i), rtcGetHitFromHitN(lane_hits, 8, i), hits[i].emplace());
   }
 }
 
