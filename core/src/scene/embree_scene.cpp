@@ -35,8 +35,8 @@ static bool wants_tangent_frame(bool textured, const SurfaceOptions& o) {
 
 // Commits an Embree geometry into the scene or the prototype being built, and records what its hits
 // need under the id Embree gave it.
-void EmbreeScene::attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
-                         const SurfaceOptions& options) {
+unsigned EmbreeScene::attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
+                             const SurfaceOptions& options) {
   rtcCommitGeometry(geom);
   unsigned id = rtcAttachGeometry(target_scene(), geom);
   rtcReleaseGeometry(geom);
@@ -48,6 +48,7 @@ void EmbreeScene::attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool te
   std::vector<Geometry>& geometries = target_geometries();
   if (geometries.size() <= id) geometries.resize(id + 1);
   geometries[id] = std::move(g);
+  return id;
 }
 
 const GeometryUserData* EmbreeScene::keep_user_data(GeometryUserData data) {
@@ -82,10 +83,11 @@ void EmbreeScene::add_mesh(std::unique_ptr<TriangleMesh> mesh, const Bsdf* bsdf,
   meshes_.push_back(std::move(mesh));
 }
 
-// User-geometry callbacks for spheres, disks and cylinders (one primitive per geometry; rays come one
-// at a time from rtcIntersect1/rtcOccluded1). On the benchmark scenes (ten triangles, two spheres)
-// Embree's native sphere primitive (RTC_GEOMETRY_TYPE_SPHERE_POINT) added about 400 instructions per
-// ray to the triangles' 412; as user geometry the spheres add about 310 (docs/bdpt.md).
+// User-geometry callbacks for spheres, disks and cylinders (one primitive per geometry). On the
+// benchmark scenes (ten triangles, two spheres) Embree's native sphere primitive
+// (RTC_GEOMETRY_TYPE_SPHERE_POINT) added about 400 instructions per ray to the triangles' 412; as
+// user geometry the spheres add about 310 (docs/bdpt.md), and tested in a loop before Embree
+// (nearest_direct_sphere(), for up to kMaxDirectSpheres) 140-210 less than that.
 static void user_bounds(const RTCBoundsFunctionArguments* args) {
   const auto* data = static_cast<const GeometryUserData*>(args->geometryUserPtr);
   Bounds3 b = data->quadric ? data->quadric->world_bounds()
@@ -163,7 +165,9 @@ void EmbreeScene::add_sphere(std::unique_ptr<Sphere> sphere, const Bsdf* bsdf, c
   Geometry g;
   g.sphere = sphere.get();
   if (light) g.lights.push_back(light);
-  attach(geom, std::move(g), bsdf, textured, media, options);
+  bool top_level = target_ < 0;
+  unsigned id = attach(geom, std::move(g), bsdf, textured, media, options);
+  if (top_level && !options.cutout.active()) direct_spheres_.push_back({sphere.get(), id});
   spheres_.push_back(std::move(sphere));
 }
 
@@ -228,7 +232,28 @@ void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const
   for (size_t i = 0; i < lights_.size(); ++i) light_pmfs_[i] = light_distribution_.discrete_pmf(i);
 }
 
-void EmbreeScene::commit() { rtcCommitScene(scene_); }
+void EmbreeScene::commit() {
+  if (has_curves_ || direct_spheres_.size() > kMaxDirectSpheres) direct_spheres_.clear();
+  for (const DirectSphere& d : direct_spheres_) rtcDisableGeometry(rtcGetGeometry(scene_, d.id));
+  rtcCommitScene(scene_);
+}
+
+unsigned EmbreeScene::nearest_direct_sphere(const Ray& ray, float* t_max) const {
+  unsigned id = RTC_INVALID_GEOMETRY_ID;
+  for (const DirectSphere& d : direct_spheres_)
+    if (auto t = d.sphere->intersect(ray, 0.f, *t_max)) {
+      *t_max = *t;
+      id = d.id;
+    }
+  return id;
+}
+
+void EmbreeScene::fill_direct_sphere_hit(const Ray& ray, float t, unsigned id, SurfaceInteraction& si) const {
+  RTCHit hit{};  // as user_intersect() reports a sphere: the surface is rebuilt from t
+  hit.geomID = id;
+  hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  fill_hit(ray, t, hit, si);
+}
 
 int EmbreeScene::begin_prototype() {
   if (target_ >= 0) throw Error("object definitions cannot nest");
@@ -338,9 +363,15 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   rtcInitIntersectContext(&ctx);
   float t_scale, t_shift;
   RTCRayHit rh = embree_ray(ray, &t_scale, &t_shift);
+  // Spheres outside Embree first (never with curves, so t needs no rescaling): Embree then looks
+  // only for something nearer.
+  unsigned sphere = direct_spheres_.empty() ? RTC_INVALID_GEOMETRY_ID : nearest_direct_sphere(ray, &rh.ray.tfar);
   rtcIntersect1(scene_, &ctx, &rh);
   std::optional<SurfaceInteraction> out;  // filled where the caller receives it (no copy out)
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return out;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+    if (sphere != RTC_INVALID_GEOMETRY_ID) fill_direct_sphere_hit(ray, rh.ray.tfar, sphere, out.emplace());
+    return out;
+  }
   if (has_curves_) rh.ray.tfar = (rh.ray.tfar - t_shift) / t_scale;
   fill_hit(ray, rh.ray.tfar, rh.hit, out.emplace());
   return out;
@@ -357,12 +388,14 @@ void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::opti
   // Each lane is the ray intersect() would trace (make_rayhit()); empty lanes are masked off.
   alignas(32) int valid[8];
   alignas(32) RTCRayHit8 packet;
+  unsigned spheres[8];
   RTCRayN* lanes = RTCRayHitN_RayN(reinterpret_cast<RTCRayHitN*>(&packet), 8);
   RTCHitN* lane_hits = RTCRayHitN_HitN(reinterpret_cast<RTCRayHitN*>(&packet), 8);
   for (unsigned i = 0; i < 8; ++i) {
     const Ray* r = i < rays.size() ? rays[i] : nullptr;
     valid[i] = r ? -1 : 0;
     RTCRayHit one = make_rayhit(r ? *r : Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f), -Infinity});
+    spheres[i] = r && !direct_spheres_.empty() ? nearest_direct_sphere(*r, &one.ray.tfar) : RTC_INVALID_GEOMETRY_ID;
     RTCRayN_org_x(lanes, 8, i) = one.ray.org_x, RTCRayN_org_y(lanes, 8, i) = one.ray.org_y;
     RTCRayN_org_z(lanes, 8, i) = one.ray.org_z, RTCRayN_tnear(lanes, 8, i) = one.ray.tnear;
     RTCRayN_dir_x(lanes, 8, i) = one.ray.dir_x, RTCRayN_dir_y(lanes, 8, i) = one.ray.dir_y;
@@ -380,7 +413,11 @@ void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::opti
     hits[i].reset();
     if (!rays[i]) continue;
     count_ray();
-    if (RTCHitN_geomID(lane_hits, 8, i) == RTC_INVALID_GEOMETRY_ID) continue;
+    if (RTCHitN_geomID(lane_hits, 8, i) == RTC_INVALID_GEOMETRY_ID) {
+      if (spheres[i] != RTC_INVALID_GEOMETRY_ID)
+        fill_direct_sphere_hit(*rays[i], RTCRayN_tfar(lanes, 8, i), spheres[i], hits[i].emplace());
+      continue;
+    }
     fill_hit(*rays[i], RTCRayN_tfar(lanes, 8, i), rtcGetHitFromHitN(lane_hits, 8, i), hits[i].emplace());
   }
 }
@@ -512,6 +549,8 @@ bool EmbreeScene::occluded(const Ray& ray) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   float t_scale, t_shift;
+  for (const DirectSphere& d : direct_spheres_)
+    if (d.sphere->intersect(ray, 0.f, ray.tmax)) return true;
   RTCRay r = embree_ray(ray, &t_scale, &t_shift).ray;
   rtcOccluded1(scene_, &ctx, &r);
   return r.tfar < 0.f;

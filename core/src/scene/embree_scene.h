@@ -1,5 +1,5 @@
 // The renderable scene: Embree 3 geometry (triangle meshes and curves, and spheres, disks and
-// cylinders as user geometry with analytic intersection) plus what a hit
+// cylinders as user geometry with analytic intersection; a few spheres tested before Embree) plus what a hit
 // needs to become a SurfaceInteraction (material, area lights, orientation).
 #pragma once
 
@@ -92,6 +92,9 @@ class EmbreeScene final : public Scene {
   Bounds3 bounds() const override { return bounds_; }
 
   size_t triangle_count() const;
+  /// Spheres intersected by the scene itself rather than by Embree (see direct_spheres_).
+  size_t spheres_outside_embree() const { return direct_spheres_.size(); }
+  /// Embree's scene: every geometry except the spheres_outside_embree().
   RTCScene rtc_scene() const { return scene_; }
 
  private:
@@ -125,8 +128,13 @@ class EmbreeScene final : public Scene {
   void place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const;
   RTCRayHit embree_ray(const Ray& ray, float* t_scale, float* t_shift) const;
   void fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const;
-  void attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
-              const SurfaceOptions& options);
+  unsigned attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
+                  const SurfaceOptions& options);
+  /// The nearest hit on the spheres tested outside Embree with t in (0, *t_max): lowers *t_max to
+  /// it and returns the sphere's geometry id, or RTC_INVALID_GEOMETRY_ID.
+  unsigned nearest_direct_sphere(const Ray& ray, float* t_max) const;
+  /// fill_hit() for a hit on a sphere tested outside Embree.
+  void fill_direct_sphere_hit(const Ray& ray, float t, unsigned id, SurfaceInteraction& si) const;
   void add_texture_footprint(SurfaceInteraction& si, const Vec3& dpdu, const Vec3& dpdv) const;
   const GeometryUserData* keep_user_data(GeometryUserData data);
   /// An Embree user geometry of one analytic primitive (a sphere or a quadric in `data`).
@@ -144,6 +152,18 @@ class EmbreeScene final : public Scene {
   RTCScene scene_ = nullptr;
   std::vector<std::unique_ptr<TriangleMesh>> meshes_;
   std::vector<std::unique_ptr<Sphere>> spheres_;
+  // A scene with a few whole spheres (benchmark scenes: two) tests them itself, in a loop before
+  // Embree, and Embree's copies are disabled: through Embree's user geometry every ray paid for a
+  // second BVH and two callbacks, about 250 instructions, where the loop costs about 40 per sphere
+  // (docs/benchmarks.md, "Spheres outside Embree"). Top-level spheres without a cut-out qualify;
+  // with more than kMaxDirectSpheres of them, or with curves (whose rays Embree gets rescaled),
+  // every sphere stays in Embree.
+  struct DirectSphere {
+    const Sphere* sphere;
+    unsigned id;  // Embree geometry id, under which geometries_ describes it
+  };
+  static constexpr size_t kMaxDirectSpheres = 4;
+  std::vector<DirectSphere> direct_spheres_;
   std::vector<std::unique_ptr<Quadric>> quadrics_;
   std::vector<std::unique_ptr<Curves>> curves_;
   bool has_curves_ = false;  // rays then reach Embree moved back by curve_back_ (see embree_ray())
