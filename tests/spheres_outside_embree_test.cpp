@@ -135,3 +135,29 @@ TEST(SpheresOutsideEmbree, PacketsAsEmbreeUserGeometry) {
     for (int k = 0; k < 8; ++k) expect_same(a[k], b[k], static_cast<int>(i) + k);
   }
 }
+
+// Sphere::intersect() rejects rays in float before its double-precision solve() only when they
+// surely miss: on rays that graze the sphere (closest approach within 1e-4 of the radius either
+// side), rays from far away and rays leaving the surface, it answers exactly as solve() does.
+TEST(SpheresOutsideEmbree, FloatPreTestRejectsOnlyMisses) {
+  Pcg32 rng(3, 4);
+  int hits = 0, misses = 0;
+  for (int i = 0; i < 200000; ++i) {
+    float r = std::exp2(8.f * rng.next_float() - 4.f);
+    Vec3 c = (Vec3(rng.next_float(), rng.next_float(), rng.next_float()) - 0.5f) * 100.f;
+    Sphere s(glm::translate(Mat4(1.f), c), r, false);
+    // The line's closest point to the centre, at a distance near r, and a direction across it.
+    Vec3 d = sample_uniform_sphere(Vec2(rng.next_float(), rng.next_float()));
+    Vec3 side = glm::normalize(glm::cross(d, glm::abs(d.x) < 0.9f ? Vec3(1.f, 0.f, 0.f) : Vec3(0.f, 1.f, 0.f)));
+    float approach = r * (i % 4 == 0 ? 1.f + 1e-4f * (2.f * rng.next_float() - 1.f) : 1.2f * rng.next_float());
+    float back = i % 3 == 0 ? r * 1e4f * rng.next_float() : 3.f * r * (2.f * rng.next_float() - 1.f);
+    Ray ray{c + approach * side - back * d, d * (0.5f + rng.next_float()), Infinity};
+    if (i % 5 == 0) ray.o = c + r * glm::normalize(ray.o - c);  // on the surface
+    auto fast = s.intersect(ray, 0.f, Infinity), exact = s.solve(ray, 0.f, Infinity);
+    ASSERT_EQ(bool(fast), bool(exact)) << "ray " << i;
+    if (exact) EXPECT_EQ(*fast, *exact) << "ray " << i;
+    (exact ? hits : misses)++;
+  }
+  EXPECT_GT(hits, 50000);
+  EXPECT_GT(misses, 50000);
+}

@@ -16,7 +16,7 @@ Vec3 Sphere::normal_at(const Vec3& p) const {
   return inward_ ? -n : n;
 }
 
-std::optional<float> Sphere::intersect(const Ray& ray, float t_min, float t_max) const {
+std::optional<float> Sphere::solve(const Ray& ray, float t_min, float t_max) const {
   glm::dvec3 oc = glm::dvec3(ray.o) - glm::dvec3(center_);
   glm::dvec3 d(ray.d);
   double a = glm::dot(d, d);
