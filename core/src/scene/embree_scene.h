@@ -154,8 +154,8 @@ class EmbreeScene final : public Scene {
   std::vector<std::unique_ptr<Sphere>> spheres_;
   // A scene with a few whole spheres (benchmark scenes: two) tests them itself, in a loop before
   // Embree, and Embree's copies are disabled: through Embree's user geometry every ray paid for a
-  // second BVH and two callbacks, about 250 instructions, where the loop costs about 40 per sphere
-  // (docs/benchmarks.md, "Spheres outside Embree"). Top-level spheres without a cut-out qualify;
+  // second BVH and the callbacks; the loop costs 140-210 instructions per ray less on the benchmark
+  // scenes (docs/benchmarks.md, "Spheres outside Embree"). Top-level spheres without a cut-out qualify;
   // with more than kMaxDirectSpheres of them, or with curves (whose rays Embree gets rescaled),
   // every sphere stays in Embree.
   struct DirectSphere {

@@ -1,5 +1,5 @@
 // Full spheres, placed by a similarity transform (rotation, uniform scale, translation): intersected
-// (as Embree user geometry, EmbreeScene::add_sphere), sampled and parameterised here.
+// (as Embree user geometry, or by EmbreeScene's own loop for up to four), sampled and parameterised here.
 #pragma once
 
 #include <penumbra/interaction.h>
