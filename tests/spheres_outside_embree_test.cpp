@@ -155,7 +155,9 @@ TEST(SpheresOutsideEmbree, FloatPreTestRejectsOnlyMisses) {
     if (i % 5 == 0) ray.o = c + r * glm::normalize(ray.o - c);  // on the surface
     auto fast = s.intersect(ray, 0.f, Infinity), exact = s.solve(ray, 0.f, Infinity);
     ASSERT_EQ(bool(fast), bool(exact)) << "ray " << i;
-    if (exact) EXPECT_EQ(*fast, *exact) << "ray " << i;
+    if (exact) {
+      EXPECT_EQ(*fast, *exact) << "ray " << i;
+    }
     (exact ? hits : misses)++;
   }
   EXPECT_GT(hits, 50000);
