@@ -214,10 +214,12 @@ void SampleIntegrator::render(RenderContext& ctx) {
                 if (spectral) ts.splats.set_wavelengths(&lane.wavelengths);
                 Rgb L = sample(scene, lane.ps, *ts.samplers[k], ts.splats);
                 if (spectral) L = lane.wavelengths.to_rgb(L);
-                if (surface_aovs)
-                  film.add_surface_sample(lane.pixel, lane.ray ? trace_surface_sample(scene, *lane.ray, lane.pixel, index)
-                                                               : SurfaceSample{},
-                                          lane.fs.weight);
+                if (surface_aovs) {  // the packet's hit where there was one, else the ray once more
+                  SurfaceSample aov = !lane.ray ? SurfaceSample{}
+                                      : packets ? describe_surface_sample(hits[k], lane.pixel, index)
+                                                : trace_surface_sample(scene, *lane.ray, lane.pixel, index);
+                  film.add_surface_sample(lane.pixel, aov, lane.fs.weight);
+                }
                 if (!to_film) continue;
                 if (!is_finite(L)) {
                   ctx.report_nonfinite(lane.pixel);

@@ -6,8 +6,11 @@
 namespace penumbra {
 
 SurfaceSample trace_surface_sample(const Scene& scene, const Ray& ray, Point2i pixel, uint32_t index) {
+  return describe_surface_sample(scene.intersect(ray), pixel, index);
+}
+
+SurfaceSample describe_surface_sample(const std::optional<SurfaceInteraction>& si, Point2i pixel, uint32_t index) {
   SurfaceSample out;
-  std::optional<SurfaceInteraction> si = scene.intersect(ray);
   if (!si) return out;
   out.hit = true;
   out.normal = si->ns;

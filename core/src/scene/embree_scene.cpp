@@ -546,11 +546,11 @@ Rgb EmbreeScene::transmittance(int medium, float distance, const SampledWaveleng
 
 bool EmbreeScene::occluded(const Ray& ray) const {
   count_ray();
+  for (const DirectSphere& d : direct_spheres_)  // any hit will do, so no nearest_direct_sphere()
+    if (d.sphere->intersect(ray, 0.f, ray.tmax)) return true;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   float t_scale, t_shift;
-  for (const DirectSphere& d : direct_spheres_)
-    if (d.sphere->intersect(ray, 0.f, ray.tmax)) return true;
   RTCRay r = embree_ray(ray, &t_scale, &t_shift).ray;
   rtcOccluded1(scene_, &ctx, &r);
   return r.tfar < 0.f;
