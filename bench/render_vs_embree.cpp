@@ -2,7 +2,7 @@
 // Cornell box and (2) Embree's raw throughput for incoherent closest-hit and shadow rays with no
 // shading, and prints their ratio.
 // Usage: penumbra-bench-render [--scene FILE] [--threads N] [--spp N] [--res N] [--rays N] [--rounds N]
-//                              [--raw-only] [--camera-packets] [--json]
+//                              [--raw-only] [--camera-packets] [--minimal] [--json]
 //   --rounds N        the render and the raw measurement alternate N times per thread count (default 5);
 //                     each round gives a ratio, and the median ratio and the range are reported, so a
 //                     drift of the machine between the two measurements moves one round, not the figure
@@ -10,7 +10,11 @@
 //                     spheres the scene tests outside Embree, up to four, are not in Embree's scene)
 //   --camera-packets  only the scene's camera rays at its film resolution (about --rays of them), one
 //                     at a time and as 8-wide packets
+//   --minimal         each round also renders with bench/minimal_path_tracer.h, the same estimator written
+//                     straight on Embree (Lambertian triangles and area lights only), and reports its ray
+//                     rate and ratio to raw Embree: what the renderer's ratio could be without its overheads
 //   --json            one JSON object per thread count on stdout instead of the table
+#include "minimal_path_tracer.h"
 #include "number_options.h"
 #include "parser/scene_description.h"
 #include "registry/registry.h"
@@ -191,7 +195,7 @@ CameraRays camera_rays(RTCScene scene, const Camera& camera, Point2i res, int th
 int main(int argc, char** argv) {
   int spp = 32, res = 256, rounds = 5, threads_option = 0;
   size_t n_rays = 2'000'000;
-  bool raw_only = false, json = false, camera_packets = false;
+  bool raw_only = false, json = false, camera_packets = false, minimal = false;
   std::string scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
   CLI::App app{"The path tracer's ray rate against raw Embree on the same geometry"};
   app.add_option("--scene", scene_file, "pbrt-v4 scene file (default: the bundled Cornell box)")
@@ -207,6 +211,7 @@ int main(int argc, char** argv) {
       ->check(cli::whole_number(1, 1000, "a whole number of rounds from 1 to 1000"));
   app.add_flag("--raw-only", raw_only, "only raw Embree on the scene's geometry");
   app.add_flag("--camera-packets", camera_packets, "only the camera rays, one at a time and as 8-wide packets");
+  app.add_flag("--minimal", minimal, "also the minimal path tracer on raw Embree, in every round");
   app.add_flag("--json", json, "one JSON object per thread count instead of the table");
   if (std::optional<int> exit_code = cli::parse_tool_options(app, argc, argv, "penumbra-bench-render:"))
     return *exit_code;
@@ -215,6 +220,18 @@ int main(int argc, char** argv) {
     SceneDescription desc = parse_scene_file(scene_file);
     Registry registry(Registry::default_search_dirs());
     BuiltScene built = build_scene(desc, registry);
+    if (minimal && (raw_only || camera_packets)) throw Error("--minimal goes with the render, not --raw-only or --camera-packets");
+    // The minimal tracer renders the scene at the render's resolution, with its maxdepth and rrdepth.
+    std::optional<BuiltScene> at_res;
+    std::optional<MinimalPathTracer> minimal_tracer;
+    if (minimal) {
+      SceneDescription d = parse_scene_file(scene_file);
+      d.film.params.set_int("xresolution", res);
+      d.film.params.set_int("yresolution", res);
+      at_res.emplace(build_scene(d, registry));
+      minimal_tracer.emplace(*at_res->scene, d.integrator.params.get_int("maxdepth", 5),
+                             d.integrator.params.get_int("rrdepth", 3));
+    }
     if (size_t n = built.scene->spheres_outside_embree())
       fmt::print(stderr, "note: {} sphere(s) of {} are tested outside Embree (EmbreeScene); the raw Embree "
                  "figures leave them out\n", n, scene_file);
@@ -233,6 +250,8 @@ int main(int argc, char** argv) {
     // Rounds of (path render, raw Embree) on each thread count; rates and ratios are medians over rounds.
     struct Rounds {
       std::vector<double> path_mrays, path_msamples, closest, shadow, mixed, ratio;
+      std::vector<double> minimal_mrays, minimal_ratio;  // with --minimal
+      double path_rays_per_sample = 0, path_mean = 0, minimal_rays_per_sample = 0, minimal_mean = 0;
     };
     auto measure = [&](int threads) {
       Rounds r;
@@ -244,15 +263,27 @@ int main(int argc, char** argv) {
           settings.resolution = std::make_pair(res, res);
           settings.threads = threads;
           settings.quiet = true;
-          RenderStats s = render(settings).stats;
+          RenderResult result = render(settings);
+          const RenderStats& s = result.stats;
           r.path_mrays.push_back(s.mrays_per_second());
           r.path_msamples.push_back(s.pixels * double(s.spp) / s.seconds * 1e-6);
+          r.path_rays_per_sample = s.rays / (s.pixels * double(s.spp));
+          double total = 0;
+          for (float v : result.image.pixels) total += v;
+          r.path_mean = total / result.image.pixels.size();
+        }
+        if (minimal_tracer) {
+          MinimalRenderResult m = minimal_tracer->render(Point2i(res, res), spp, threads, round);
+          r.minimal_mrays.push_back(m.rays / m.seconds * 1e-6);
+          r.minimal_rays_per_sample = m.rays / double(m.samples);
+          r.minimal_mean = m.mean;
         }
         RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
         r.closest.push_back(raw.closest_mrays);
         r.shadow.push_back(raw.shadow_mrays);
         r.mixed.push_back(raw.mixed_mrays);
         if (!raw_only) r.ratio.push_back(r.path_mrays.back() / raw.mixed_mrays);
+        if (minimal_tracer) r.minimal_ratio.push_back(r.minimal_mrays.back() / raw.mixed_mrays);
       }
       return r;
     };
@@ -271,6 +302,14 @@ int main(int argc, char** argv) {
           j["ratio"] = median(r.ratio);
           j["ratio_min"] = *std::min_element(r.ratio.begin(), r.ratio.end());
           j["ratio_max"] = *std::max_element(r.ratio.begin(), r.ratio.end());
+        }
+        if (minimal) {
+          j["minimal_mrays_per_second"] = median(r.minimal_mrays);
+          j["minimal_ratio"] = median(r.minimal_ratio);
+          j["path_rays_per_sample"] = r.path_rays_per_sample;
+          j["minimal_rays_per_sample"] = r.minimal_rays_per_sample;
+          j["path_image_mean"] = r.path_mean;
+          j["minimal_image_mean"] = r.minimal_mean;
         }
         j["raw_closest_mrays_per_second"] = median(r.closest);
         j["raw_shadow_mrays_per_second"] = median(r.shadow);
@@ -296,6 +335,13 @@ int main(int argc, char** argv) {
                  100.0 * median(r.ratio),
                  fmt::format("[{:.1f}, {:.1f}]", 100.0 * *std::min_element(r.ratio.begin(), r.ratio.end()),
                              100.0 * *std::max_element(r.ratio.begin(), r.ratio.end())));
+      if (minimal)
+        fmt::print("{:>7} minimal path tracer on raw Embree: {:.2f} Mrays/s, ratio {:.1f}% [{:.1f}, {:.1f}]; rays per "
+                   "sample {:.3f} (path {:.3f}); image mean {:.5f} (path {:.5f})\n",
+                   threads, median(r.minimal_mrays), 100.0 * median(r.minimal_ratio),
+                   100.0 * *std::min_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
+                   100.0 * *std::max_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
+                   r.minimal_rays_per_sample, r.path_rays_per_sample, r.minimal_mean, r.path_mean);
     }
   } catch (const Error& e) {
     fmt::print(stderr, "{}\n", e.formatted());

@@ -423,6 +423,13 @@ void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::opti
 }
 
 // The surface at a hit Embree reported at distance t along `ray` (in the ray's own units).
+EmbreeScene::GeometryView EmbreeScene::geometry_view(unsigned id, unsigned prim) const {
+  if (id >= geometries_.size() || (id < instances_.size() && instances_[id].prototype >= 0))
+    return {nullptr, nullptr, nullptr};
+  const Geometry& g = geometries_[id];
+  return {g.mesh, g.bsdf, g.lights.empty() ? nullptr : g.lights.at(g.mesh ? prim : 0)};
+}
+
 void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const {
   // A hit inside an instance is computed in the prototype's space and then placed.
   const Instance* inst = hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[hit.instID[0]] : nullptr;

@@ -16,6 +16,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -96,6 +97,17 @@ class EmbreeScene final : public Scene {
   size_t spheres_outside_embree() const { return direct_spheres_.size(); }
   /// Embree's scene: every geometry except the spheres_outside_embree().
   RTCScene rtc_scene() const { return scene_; }
+
+  /// What top-level Embree geometry `id` is, for tools that trace rtc_scene() themselves (bench/):
+  /// its triangle mesh (null for other shapes and instances), its BSDF, and the light of its
+  /// primitive `prim` (null if it does not emit). Ids run from 0 to geometry_count() - 1.
+  struct GeometryView {
+    const TriangleMesh* mesh;
+    const Bsdf* bsdf;
+    const Light* light;
+  };
+  size_t geometry_count() const { return std::max(geometries_.size(), instances_.size()); }
+  GeometryView geometry_view(unsigned id, unsigned prim) const;
 
  private:
   struct Geometry {
