@@ -56,7 +56,10 @@ MinimalPathTracer::MinimalPathTracer(const EmbreeScene& scene, int max_depth, in
       t.albedo = Pi * g.bsdf->f(Vec3(0.f, 0.f, 1.f), Vec3(0.f, 0.f, 1.f), ctx);
       t.area = 0.5f * glm::length(glm::cross(t.e1, t.e2));
       t.le_front = t.le_back = Rgb(0.f);
-      if (const Light* light = scene.geometry_view(id, static_cast<unsigned>(i)).light) {
+      t.bsdf = g.bsdf;
+      const Light* light = scene.geometry_view(id, static_cast<unsigned>(i)).light;
+      tri_lights_.push_back(light);
+      if (light) {
         Vec3 c = p0 + (t.e1 + t.e2) / 3.f;
         t.le_front = light->L(c, t.n, Vec2(0.f), t.n);
         t.le_back = light->L(c, t.n, Vec2(0.f), -t.n);
@@ -73,79 +76,144 @@ MinimalPathTracer::MinimalPathTracer(const EmbreeScene& scene, int max_depth, in
   for (uint32_t e : emitters_) emitter_cdf_.push_back(emitter_cdf_.back() + emitter_pmf_[e]);
 }
 
+template <unsigned kLayers>
 Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed, uint64_t* rays) const {
   Pcg32 rng(stream, seed);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
+  const ShadingContext sctx;
   Rgb L(0.f), beta(1.f);
-  Vec3 o = camera_ray.o, d = camera_ray.d;
+  Ray ray = camera_ray;
   float tnear = 0.f, bsdf_pdf = 0.f;
+  LightSampleContext prev{};  // the vertex that sampled `ray` (kLights)
   for (int depth = 0;; ++depth) {
-    RTCRayHit rh;
-    rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z, rh.ray.tnear = tnear;
-    rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z, rh.ray.time = 0.f;
-    rh.ray.tfar = Infinity, rh.ray.mask = 0xFFFFFFFFu, rh.ray.id = 0, rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_.rtc_scene(), &ctx, &rh);
-    ++*rays;
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
-    const uint32_t index = first_triangle_[rh.hit.geomID] + rh.hit.primID;
+    // The hit: its triangle, point and the side the ray arrives on.
+    std::optional<SurfaceInteraction> si;
+    uint32_t index;
+    float t;
+    if constexpr ((kLayers & kHits) != 0) {
+      si = scene_.intersect(ray);
+      ++*rays;
+      if (!si) break;
+      index = first_triangle_[si->shape_id] + si->prim_id;
+      t = si->t;
+    } else {
+      RTCRayHit rh;
+      rh.ray.org_x = ray.o.x, rh.ray.org_y = ray.o.y, rh.ray.org_z = ray.o.z, rh.ray.tnear = tnear;
+      rh.ray.dir_x = ray.d.x, rh.ray.dir_y = ray.d.y, rh.ray.dir_z = ray.d.z, rh.ray.time = 0.f;
+      rh.ray.tfar = Infinity, rh.ray.mask = 0xFFFFFFFFu, rh.ray.id = 0, rh.ray.flags = 0;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(scene_.rtc_scene(), &ctx, &rh);
+      ++*rays;
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+      index = first_triangle_[rh.hit.geomID] + rh.hit.primID;
+      t = rh.ray.tfar;
+    }
     const Triangle& tri = triangles_[index];
-    const Vec3 p = o + rh.ray.tfar * d;
-    const float cos_o = glm::dot(tri.n, d);  // < 0: the ray arrives on the side of n
+    const Vec3 p = (kLayers & kHits) != 0 ? si->p : ray.o + t * ray.d;
+    const float cos_o = glm::dot(tri.n, ray.d);  // < 0: the ray arrives on the side of n
     const Rgb& le = cos_o < 0.f ? tri.le_front : tri.le_back;
     if (le.r > 0.f || le.g > 0.f || le.b > 0.f) {
       if (depth == 0) {
         L += beta * le;
       } else {
-        float dist2 = rh.ray.tfar * rh.ray.tfar * glm::dot(d, d);
-        float light_pdf = emitter_pmf_[index] * dist2 * glm::length(d) / (std::abs(cos_o) * tri.area);
+        float light_pdf;
+        if constexpr ((kLayers & kLights) != 0) {
+          SurfaceInteraction stub;
+          if constexpr ((kLayers & kHits) != 0) stub = *si;
+          else stub.p = p, stub.ng = tri.n;
+          const Light* light = tri_lights_[index];
+          light_pdf = scene_.light_pmf(light) * light->pdf_li(prev, ray.d, stub);
+        } else {
+          float dist2 = t * t * glm::dot(ray.d, ray.d);
+          light_pdf = emitter_pmf_[index] * dist2 * glm::length(ray.d) / (std::abs(cos_o) * tri.area);
+        }
         L += beta * le * power_heuristic(1, bsdf_pdf, 1, light_pdf);
       }
     }
     if (depth == max_depth_) break;
     const Vec3 n = cos_o < 0.f ? tri.n : -tri.n;  // facing the incoming ray
-    const Rgb f = tri.albedo * InvPi;
+    const Frame frame = (kLayers & kHits) != 0 ? si->shading : Frame(n);
+    const Vec3 wo_local = frame.to_local(-glm::normalize(ray.d));
 
     // Next-event estimation: a light by power, a point on it uniformly by area.
     float u_light = rng.next_float();
     Vec2 u_point(rng.next_float(), rng.next_float());
-    size_t k = std::min<size_t>(std::upper_bound(emitter_cdf_.begin(), emitter_cdf_.end(), u_light) -
-                                    emitter_cdf_.begin() - 1, emitters_.size() - 1);
-    const uint32_t e = emitters_[k];
-    const Triangle& light = triangles_[e];
-    float su = std::sqrt(u_point.x);
-    Vec3 q = light.p0 + su * (1.f - u_point.y) * light.e1 + su * u_point.y * light.e2;
-    Vec3 wi = q - p;
-    float dist2 = glm::dot(wi, wi), dist = std::sqrt(dist2);
-    wi /= dist;
-    float cos_i = glm::dot(wi, n), cos_l = glm::dot(wi, light.n);
-    const Rgb& le_l = cos_l < 0.f ? light.le_front : light.le_back;
-    if (cos_i > 0.f && cos_l != 0.f && (le_l.r > 0.f || le_l.g > 0.f || le_l.b > 0.f)) {
-      RTCRay shadow;
-      shadow.org_x = p.x, shadow.org_y = p.y, shadow.org_z = p.z, shadow.tnear = kTnear;
-      shadow.dir_x = wi.x, shadow.dir_y = wi.y, shadow.dir_z = wi.z, shadow.time = 0.f;
-      shadow.tfar = dist * (1.f - 1e-4f), shadow.mask = 0xFFFFFFFFu, shadow.id = 0, shadow.flags = 0;
-      rtcOccluded1(scene_.rtc_scene(), &ctx, &shadow);
-      ++*rays;
-      if (shadow.tfar >= 0.f) {
-        float light_pdf = emitter_pmf_[e] * dist2 / (std::abs(cos_l) * light.area);
-        float w = power_heuristic(1, light_pdf, 1, cos_i * InvPi);
-        L += beta * f * le_l * (cos_i * w / light_pdf);
+    Vec3 q, wi, n_light;
+    Rgb le_l;
+    float light_pdf = 0.f;
+    if constexpr ((kLayers & kLights) != 0) {
+      if (std::optional<SampledLight> sl = scene_.sample_light(u_light)) {
+        if (std::optional<LightLiSample> ls = sl->light->sample_li(LightSampleContext{p, n, true}, u_point)) {
+          q = ls->p_light, wi = ls->wi, n_light = ls->n_light, le_l = ls->L;
+          light_pdf = sl->pmf * ls->pdf;
+        }
       }
+    } else {
+      size_t k = std::min<size_t>(std::upper_bound(emitter_cdf_.begin(), emitter_cdf_.end(), u_light) -
+                                      emitter_cdf_.begin() - 1, emitters_.size() - 1);
+      const uint32_t e = emitters_[k];
+      const Triangle& light = triangles_[e];
+      float su = std::sqrt(u_point.x);
+      q = light.p0 + su * (1.f - u_point.y) * light.e1 + su * u_point.y * light.e2;
+      wi = q - p;
+      float dist2 = glm::dot(wi, wi), dist = std::sqrt(dist2);
+      wi /= dist;
+      float cos_l = glm::dot(wi, light.n);
+      n_light = light.n;
+      le_l = cos_l < 0.f ? light.le_front : light.le_back;
+      if (cos_l != 0.f) light_pdf = emitter_pmf_[e] * dist2 / (std::abs(cos_l) * light.area);
+    }
+    const float cos_i = glm::dot(wi, n);
+    if (light_pdf > 0.f && cos_i > 0.f && (le_l.r > 0.f || le_l.g > 0.f || le_l.b > 0.f)) {
+      Rgb f_cos;
+      float pdf_bsdf;
+      if constexpr ((kLayers & kBsdf) != 0) {
+        Vec3 wi_local = frame.to_local(wi);
+        f_cos = tri.bsdf->f(wo_local, wi_local, sctx) * std::abs(wi_local.z);
+        pdf_bsdf = tri.bsdf->pdf(wo_local, wi_local, sctx);
+      } else {
+        f_cos = tri.albedo * (InvPi * cos_i);
+        pdf_bsdf = cos_i * InvPi;
+      }
+      bool occluded;
+      if constexpr ((kLayers & kHits) != 0) {
+        occluded = scene_.occluded(si->spawn_ray_to(q, n_light));
+      } else {
+        RTCRay shadow;
+        Vec3 to = q - p;
+        shadow.org_x = p.x, shadow.org_y = p.y, shadow.org_z = p.z, shadow.tnear = kTnear / glm::length(to);
+        shadow.dir_x = to.x, shadow.dir_y = to.y, shadow.dir_z = to.z, shadow.time = 0.f;
+        shadow.tfar = 1.f - 1e-4f, shadow.mask = 0xFFFFFFFFu, shadow.id = 0, shadow.flags = 0;
+        rtcOccluded1(scene_.rtc_scene(), &ctx, &shadow);
+        occluded = shadow.tfar < 0.f;
+      }
+      ++*rays;
+      if (!occluded) L += beta * f_cos * le_l * (power_heuristic(1, light_pdf, 1, pdf_bsdf) / light_pdf);
     }
 
-    // Cosine-weighted continuation: the Lambertian's f cos / pdf is its albedo.
+    // Continuation by BSDF sampling.
+    float u_lobe = rng.next_float();
     Vec2 u_dir(rng.next_float(), rng.next_float());
     float u_rr = rng.next_float();
-    Vec3 local = sample_cosine_hemisphere(u_dir);
-    if (!(local.z > 0.f)) break;
-    Frame frame(n);
-    d = frame.to_world(local);
-    bsdf_pdf = local.z * InvPi;
-    beta *= tri.albedo;
-    o = p;
+    Vec3 w_local;
+    if constexpr ((kLayers & kBsdf) != 0) {
+      std::optional<BsdfSample> bs = tri.bsdf->sample_f(wo_local, u_lobe, u_dir, sctx);
+      if (!bs || !(bs->pdf > 0.f)) break;
+      w_local = bs->wi;
+      bsdf_pdf = bs->pdf;
+      beta *= bs->f * std::abs(bs->wi.z) / bs->pdf;
+    } else {
+      w_local = sample_cosine_hemisphere(u_dir);
+      if (!(w_local.z > 0.f)) break;
+      bsdf_pdf = w_local.z * InvPi;
+      beta *= tri.albedo;  // the Lambertian's f cos / pdf
+    }
+    const Vec3 d = frame.to_world(w_local);
+    if constexpr ((kLayers & kLights) != 0) prev = LightSampleContext{p, n, true};
+    if constexpr ((kLayers & kHits) != 0) ray = si->spawn_ray(d);
+    else ray = Ray{p, d, Infinity};
     tnear = kTnear;
     if (depth + 1 >= rr_depth_) {
       float q_end = std::max(0.f, 1.f - max_component(beta));
@@ -156,7 +224,8 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
   return L;
 }
 
-MinimalRenderResult MinimalPathTracer::render(Point2i res, int spp, int threads, uint64_t seed) const {
+template <unsigned kLayers>
+MinimalRenderResult MinimalPathTracer::render_with(Point2i res, int spp, int threads, uint64_t seed) const {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   std::vector<Rgb> pixels(static_cast<size_t>(res.x) * res.y, Rgb(0.f));
   tbb::combinable<uint64_t> rays([] { return uint64_t{0}; });
@@ -172,7 +241,7 @@ MinimalRenderResult MinimalPathTracer::render(Point2i res, int spp, int threads,
         for (int s = 0; s < spp; ++s) {
           CameraSample cs{Vec2(x + jitter.next_float(), y + jitter.next_float())};
           std::optional<Ray> ray = camera.generate_ray(cs);
-          if (ray) sum += Li(*ray, pixel * static_cast<uint64_t>(spp) + s, seed, &n);
+          if (ray) sum += Li<kLayers>(*ray, pixel * static_cast<uint64_t>(spp) + s, seed, &n);
         }
         pixels[pixel] = sum / static_cast<float>(spp);
       }
@@ -185,6 +254,16 @@ MinimalRenderResult MinimalPathTracer::render(Point2i res, int spp, int threads,
   for (const Rgb& c : pixels) total += (c.r + c.g + c.b) / 3.0;
   r.mean = total / pixels.size();
   return r;
+}
+
+MinimalRenderResult MinimalPathTracer::render(Point2i res, int spp, int threads, uint64_t seed, unsigned layers) const {
+  switch (layers) {
+    case kMinimalOnly: return render_with<kMinimalOnly>(res, spp, threads, seed);
+    case kHits: return render_with<kHits>(res, spp, threads, seed);
+    case kHits | kLights: return render_with<kHits | kLights>(res, spp, threads, seed);
+    case kHits | kLights | kBsdf: return render_with<kHits | kLights | kBsdf>(res, spp, threads, seed);
+    default: throw Error(fmt::format("minimal path tracer: layers {} are not built (0, 1, 3 and 7 are)", layers));
+  }
 }
 
 }  // namespace penumbra

@@ -9,6 +9,11 @@
 // renderer: plugins and virtual calls per vertex, samplers, hit records with shading frames and
 // texture footprints, robust ray offsets (it starts rays at a fixed tnear), pixel filters (a box),
 // AOVs, checkpoints, progress. The constructor refuses any other scene with an Error.
+//
+// Layers put the renderer's own pieces back one at a time, so that the cost of each shows as a
+// difference in time at the same estimator: kHits traces through Scene::intersect() and occluded()
+// (hit records, robust ray offsets), kLights samples lights through Scene::sample_light() and
+// Light::sample_li() / pdf_li(), kBsdf evaluates and samples the Bsdf objects in the shading frame.
 #pragma once
 
 #include "scene/embree_scene.h"
@@ -19,6 +24,8 @@
 #include <vector>
 
 namespace penumbra {
+
+enum MinimalLayers : unsigned { kMinimalOnly = 0, kHits = 1, kLights = 2, kBsdf = 4 };
 
 struct MinimalRenderResult {
   double seconds = 0.0;  // rendering only
@@ -32,7 +39,8 @@ class MinimalPathTracer {
   MinimalPathTracer(const EmbreeScene& scene, int max_depth, int rr_depth);
   /// Renders the scene's camera at `resolution` (the camera must have been built for it) with
   /// `spp` samples per pixel on `threads` threads; `seed` picks the random streams.
-  MinimalRenderResult render(Point2i resolution, int spp, int threads, uint64_t seed = 0) const;
+  MinimalRenderResult render(Point2i resolution, int spp, int threads, uint64_t seed = 0,
+                             unsigned layers = kMinimalOnly) const;
 
  private:
   struct Triangle {
@@ -41,13 +49,18 @@ class MinimalPathTracer {
     Rgb albedo;           // reflectance of the Lambertian BSDF
     Rgb le_front, le_back;  // emitted radiance on the side of n and on the other side
     float area;
+    const Bsdf* bsdf;
   };
+  template <unsigned kLayers>
   Rgb Li(const Ray& camera_ray, uint64_t stream, uint64_t seed, uint64_t* rays) const;
+  template <unsigned kLayers>
+  MinimalRenderResult render_with(Point2i resolution, int spp, int threads, uint64_t seed) const;
 
   const EmbreeScene& scene_;
   int max_depth_, rr_depth_;
   std::vector<uint32_t> first_triangle_;  // per Embree geometry id, into triangles_
   std::vector<Triangle> triangles_;
+  std::vector<const Light*> tri_lights_;  // per triangle, null where it does not emit
   std::vector<uint32_t> emitters_;        // indices into triangles_
   std::vector<float> emitter_cdf_;        // by the lights' power, emitters_.size() + 1 entries
   std::vector<float> emitter_pmf_;        // per triangle (0 for those that do not emit)

@@ -42,6 +42,9 @@
 
 using namespace penumbra;
 
+// The layers of the minimal path tracer measured with --minimal, each adding the renderer's pieces.
+constexpr unsigned kLayerSets[4] = {kMinimalOnly, kHits, kHits | kLights, kHits | kLights | kBsdf};
+
 namespace {
 
 double now() {
@@ -251,6 +254,7 @@ int main(int argc, char** argv) {
     struct Rounds {
       std::vector<double> path_mrays, path_msamples, closest, shadow, mixed, ratio;
       std::vector<double> minimal_mrays, minimal_ratio;  // with --minimal
+      std::vector<double> path_ns, layer_ns[4];          // nanoseconds per sample: path, and the layers
       double path_rays_per_sample = 0, path_mean = 0, minimal_rays_per_sample = 0, minimal_mean = 0;
     };
     auto measure = [&](int threads) {
@@ -268,6 +272,7 @@ int main(int argc, char** argv) {
           r.path_mrays.push_back(s.mrays_per_second());
           r.path_msamples.push_back(s.pixels * double(s.spp) / s.seconds * 1e-6);
           r.path_rays_per_sample = s.rays / (s.pixels * double(s.spp));
+          r.path_ns.push_back(s.seconds / (s.pixels * double(s.spp)) * 1e9);
           double total = 0;
           for (float v : result.image.pixels) total += v;
           r.path_mean = total / result.image.pixels.size();
@@ -277,6 +282,11 @@ int main(int argc, char** argv) {
           r.minimal_mrays.push_back(m.rays / m.seconds * 1e-6);
           r.minimal_rays_per_sample = m.rays / double(m.samples);
           r.minimal_mean = m.mean;
+          r.layer_ns[0].push_back(m.seconds / m.samples * 1e9);
+          for (int k = 1; k < 4; ++k) {
+            MinimalRenderResult layered = minimal_tracer->render(Point2i(res, res), spp, threads, round, kLayerSets[k]);
+            r.layer_ns[k].push_back(layered.seconds / layered.samples * 1e9);
+          }
         }
         RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
         r.closest.push_back(raw.closest_mrays);
@@ -342,6 +352,11 @@ int main(int argc, char** argv) {
                    100.0 * *std::min_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
                    100.0 * *std::max_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
                    r.minimal_rays_per_sample, r.path_rays_per_sample, r.minimal_mean, r.path_mean);
+      if (minimal) {
+        fmt::print("{:>7} ns per sample (medians): minimal {:.0f}, + hit records {:.0f}, + light sampling {:.0f}, "
+                   "+ BSDF objects {:.0f}, path integrator {:.0f}\n", threads, median(r.layer_ns[0]),
+                   median(r.layer_ns[1]), median(r.layer_ns[2]), median(r.layer_ns[3]), median(r.path_ns));
+      }
     }
   } catch (const Error& e) {
     fmt::print(stderr, "{}\n", e.formatted());

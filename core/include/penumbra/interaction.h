@@ -121,17 +121,23 @@ inline Ray spawn_ray_to(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Ve
 
 /// Everything an integrator needs about a ray hit.
 struct SurfaceInteraction {
-  Vec3 p;            // hit point, reconstructed from the primitive (not o + t d)
+  // Every member starts at zero (the frame at the axes) through its own initialiser. The constructor
+  // is user-provided so that value-initialisation (std::optional::emplace(), `SurfaceInteraction{}`)
+  // runs just these stores: with an implicit one, GCC first zero-fills the whole object with
+  // `rep stos`, whose start-up cost was 3-4 % of a path tracer's time (docs/benchmarks.md).
+  SurfaceInteraction() {}
+
+  Vec3 p{0.f};       // hit point, reconstructed from the primitive (not o + t d)
   Vec3 p_error{0.f}; // bound on the absolute error of p, per component
-  Vec3 ng;           // geometric normal, oriented as the shape defines its outside
-  Vec3 ns;           // shading normal, in the same hemisphere as ng
-  Vec2 uv;           // surface parameterisation
+  Vec3 ng{0.f};      // geometric normal, oriented as the shape defines its outside
+  Vec3 ns{0.f};      // shading normal, in the same hemisphere as ng
+  Vec2 uv{0.f};      // surface parameterisation
   // Texture lookups, filled only where the hit's material has textured parameters (otherwise zero):
   // the footprint of a pixel at the hit, estimated from the camera (Camera::approximate_dp_dxy)
   // and turned into (u, v) differences by least squares with the parameterisation's dp/du, dp/dv.
   Vec3 dpdx{0.f}, dpdy{0.f};
   float dudx = 0.f, dudy = 0.f, dvdx = 0.f, dvdy = 0.f;
-  Vec3 wo;           // unit direction back along the incoming ray
+  Vec3 wo{0.f};      // unit direction back along the incoming ray
   float t = 0.f;     // ray parameter of the hit
   Frame shading;     // frame around ns: BSDFs work in it
   const Bsdf* bsdf = nullptr;         // material at the hit (never null for scene geometry)
