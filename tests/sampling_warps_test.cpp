@@ -328,6 +328,30 @@ TEST(Distribution1D, RemappedUIsUniformWithinTheChosenBin) {
       [n](const Vec2& p) { return kSteps[std::min(int(p.y * n), n - 1)] / 17.5 * n; }, kSamples, 10, n, 23));
 }
 
+// The bin a u falls in, for few bins (counted) and many (binary search): as u grows the bin never
+// goes back, a bin of zero weight is never returned, and the bin's CDF interval holds u (the remapped
+// u is in [0, 1)). Zero bins at the start, inside and at the end, for 1 to 12 bins.
+TEST(Distribution1D, DiscreteBinsAreMonotoneInUAndNeverEmpty) {
+  for (size_t n = 1; n <= 12; ++n) {
+    std::vector<float> f(n);
+    for (size_t i = 0; i < n; ++i) f[i] = (i % 3 == 1 || i + 1 == n) && n > 1 ? 0.f : 1.f + float(i % 4);
+    Distribution1D d(f);
+    size_t previous = 0;
+    const int steps = 20000;
+    for (int k = 0; k < steps; ++k) {
+      float u = std::min(float(k) / steps, OneMinusEpsilon);
+      float remapped = -1.f;
+      size_t bin = d.sample_discrete(u, nullptr, &remapped);
+      ASSERT_LT(bin, n) << "n " << n << " u " << u;
+      EXPECT_GT(f[bin], 0.f) << "n " << n << " u " << u;
+      EXPECT_GE(bin, previous) << "n " << n << " u " << u;
+      EXPECT_GE(remapped, 0.f);
+      EXPECT_LT(remapped, 1.f);
+      previous = bin;
+    }
+  }
+}
+
 TEST(Distribution1D, AllZeroFunctionSamplesUniformlyChiSquare) {
   std::vector<float> zeros(5, 0.f);
   expect_fits(continuous_test(zeros, 24));
