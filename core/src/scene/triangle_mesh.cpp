@@ -1,6 +1,7 @@
 #include "scene/triangle_mesh.h"
 
 #include "util/cpu_clones.h"
+#include "util/triangle_warp.h"
 
 #include <penumbra/interaction.h>
 #include <penumbra/sampling.h>
@@ -115,14 +116,17 @@ ShapeSample Triangle::sample_area(Vec2 u) const {
 
 // Samples are written field by field into the object the caller returns: built whole and copied
 // out of an std::optional, they stalled store forwarding (docs/benchmarks.md, "Results built in place").
-void Triangle::fill_at(const Vec3& b, ShapeSample& s) const {
+// This, area_sample_into() and sample_by_area() are inlined into sample_solid_angle(), which every
+// light sample on a triangle goes through: out of line they were three calls deep, each result a
+// round trip through memory.
+[[gnu::always_inline]] inline void Triangle::fill_at(const Vec3& b, ShapeSample& s) const {
   s.p = b.x * p_[0] + b.y * p_[1] + b.z * p_[2];
   s.n = n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, b);
   s.uv = b.x * uv_[0] + b.y * uv_[1] + b.z * uv_[2];
 }
 
-void Triangle::area_sample_into(Vec2 u, ShapeSample& s) const {
-  Vec2 b12 = sample_uniform_triangle(u);
+[[gnu::always_inline]] inline void Triangle::area_sample_into(Vec2 u, ShapeSample& s) const {
+  Vec2 b12 = uniform_triangle_barycentrics(u);
   fill_at(Vec3(1.f - b12.x - b12.y, b12.x, b12.y), s);
   s.pdf = inv_area_;
 }
@@ -221,9 +225,10 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
   return sample_by_area(ctx, u);
 }
 
-std::optional<ShapeSample> Triangle::sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const {
-  std::optional<ShapeSample> out;
-  ShapeSample& s = out.emplace();
+[[gnu::always_inline]] inline std::optional<ShapeSample> Triangle::sample_by_area(const ShapeSampleContext& ctx,
+                                                                              Vec2 u) const {
+  std::optional<ShapeSample> out(std::in_place);
+  ShapeSample& s = *out;
   area_sample_into(u, s);
   s.pdf = area_to_solid_angle_pdf(s.pdf, ctx.p, s.p, s.n);
   if (!(s.pdf > 0.f) || std::isinf(s.pdf)) out.reset();

@@ -1,9 +1,9 @@
 #include <penumbra/sampling.h>
 
 #include "util/cpu_clones.h"
+#include "util/triangle_warp.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 
 namespace penumbra {
@@ -66,20 +66,7 @@ Vec3 sample_uniform_cone(Vec2 u, float cos_max) {
   return Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
 }
 
-Vec2 sample_uniform_triangle(Vec2 u) {
-  // Heitz's low-distortion map (used by pbrt-v4): fold the square along its diagonal and shear each
-  // half onto the triangle. Unlike the sqrt map it keeps neighbouring strata neighbours. Both halves
-  // are computed and one is selected: a branch on u would go either way at random (every light
-  // sample on a triangle comes here).
-  // (GCC turns `?:` on floats back into a branch in the baseline build, so the selects are on bits.)
-  const uint32_t upper = -static_cast<uint32_t>(u.x < u.y);  // all ones or zero
-  const float half_x = u.x / 2.f, half_y = u.y / 2.f;
-  auto select = [upper](float if_upper, float otherwise) {
-    return std::bit_cast<float>((std::bit_cast<uint32_t>(if_upper) & upper) |
-                                (std::bit_cast<uint32_t>(otherwise) & ~upper));
-  };
-  return Vec2(select(half_x, u.x - half_y), select(u.y - half_x, half_y));
-}
+Vec2 sample_uniform_triangle(Vec2 u) { return uniform_triangle_barycentrics(u); }
 
 Distribution1D::Distribution1D(std::span<const float> f) : func_(f.size()), cdf_(f.size() + 1) {
   size_t n = f.size();
