@@ -58,20 +58,19 @@ MinimalPathTracer::MinimalPathTracer(const EmbreeScene& scene, int max_depth, in
       t.le_front = t.le_back = Rgb(0.f);
       t.bsdf = g.bsdf;
       const Light* light = scene.geometry_view(id, static_cast<unsigned>(i)).light;
-      tri_lights_.push_back(light);
+      const float pmf = light ? scene.light_pmf(light) : 0.f;
       if (light) {
         Vec3 c = p0 + (t.e1 + t.e2) / 3.f;
         t.le_front = light->L(c, t.n, Vec2(0.f), t.n);
         t.le_back = light->L(c, t.n, Vec2(0.f), -t.n);
-        if (scene.light_pmf(light) > 0.f) emitters_.push_back(static_cast<uint32_t>(triangles_.size()));
-        emitter_pmf_.resize(triangles_.size() + 1, 0.f);
-        emitter_pmf_.back() = scene.light_pmf(light);
+        if (pmf > 0.f) emitters_.push_back(static_cast<uint32_t>(triangles_.size()));
       }
+      tri_lights_.push_back(light);
+      emitter_pmf_.push_back(pmf);
       triangles_.push_back(t);
     }
   }
   if (emitters_.empty()) throw Error("the minimal path tracer needs an area light");
-  emitter_pmf_.resize(triangles_.size(), 0.f);
   emitter_cdf_.push_back(0.f);
   for (uint32_t e : emitters_) emitter_cdf_.push_back(emitter_cdf_.back() + emitter_pmf_[e]);
 }
@@ -141,7 +140,8 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
     if (depth == max_depth_) break;
     const Vec3 n = cos_o < 0.f ? tri.n : -tri.n;  // facing the incoming ray
     const Frame frame = (kLayers & kHits) != 0 ? si->shading : Frame(n);
-    const Vec3 wo_local = frame.to_local(-glm::normalize(ray.d));
+    Vec3 wo_local(0.f);  // only the BSDF objects take wo
+    if constexpr ((kLayers & kBsdf) != 0) wo_local = frame.to_local(-glm::normalize(ray.d));
 
     // Next-event estimation: a light by power, a point on it uniformly by area.
     float u_light = rng.next_float();

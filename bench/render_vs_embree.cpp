@@ -221,21 +221,18 @@ int main(int argc, char** argv) {
     return *exit_code;
   std::vector<int> thread_counts = threads_option > 0 ? std::vector<int>{threads_option} : std::vector<int>{1, 2};
   try {
+    if (minimal && (raw_only || camera_packets)) throw Error("--minimal goes with the render, not --raw-only or --camera-packets");
     SceneDescription desc = parse_scene_file(scene_file);
+    if (minimal) {  // the minimal tracer uses this scene's camera at the render's resolution
+      desc.film.params.set_int("xresolution", res);
+      desc.film.params.set_int("yresolution", res);
+    }
     Registry registry(Registry::default_search_dirs());
     BuiltScene built = build_scene(desc, registry);
-    if (minimal && (raw_only || camera_packets)) throw Error("--minimal goes with the render, not --raw-only or --camera-packets");
-    // The minimal tracer renders the scene at the render's resolution, with its maxdepth and rrdepth.
-    std::optional<BuiltScene> at_res;
     std::optional<MinimalPathTracer> minimal_tracer;
-    if (minimal) {
-      SceneDescription d = parse_scene_file(scene_file);
-      d.film.params.set_int("xresolution", res);
-      d.film.params.set_int("yresolution", res);
-      at_res.emplace(build_scene(d, registry));
-      minimal_tracer.emplace(*at_res->scene, d.integrator.params.get_int("maxdepth", 5),
-                             d.integrator.params.get_int("rrdepth", 3));
-    }
+    if (minimal)
+      minimal_tracer.emplace(*built.scene, desc.integrator.params.get_int("maxdepth", 5),
+                             desc.integrator.params.get_int("rrdepth", 3));
     if (size_t n = built.scene->spheres_outside_embree())
       fmt::print(stderr, "note: {} sphere(s) of {} are tested outside Embree (EmbreeScene); the raw Embree "
                  "figures leave them out\n", n, scene_file);
@@ -353,14 +350,13 @@ int main(int argc, char** argv) {
                  100.0 * median(r.ratio),
                  fmt::format("[{:.1f}, {:.1f}]", 100.0 * *std::min_element(r.ratio.begin(), r.ratio.end()),
                              100.0 * *std::max_element(r.ratio.begin(), r.ratio.end())));
-      if (minimal)
+      if (minimal) {
         fmt::print("{:>7} minimal path tracer on raw Embree: {:.2f} Mrays/s, ratio {:.1f}% [{:.1f}, {:.1f}]; rays per "
                    "sample {:.3f} (path {:.3f}); image mean {:.5f} (path {:.5f})\n",
                    threads, median(r.minimal_mrays), 100.0 * median(r.minimal_ratio),
                    100.0 * *std::min_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
                    100.0 * *std::max_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
                    r.minimal_rays_per_sample, r.path_rays_per_sample, r.minimal_mean, r.path_mean);
-      if (minimal) {
         fmt::print("{:>7} ns per sample (medians): minimal {:.0f}, + hit records {:.0f}, + light sampling {:.0f}, "
                    "+ BSDF objects {:.0f}, path integrator {:.0f}\n", threads, median(r.layer_ns[0]),
                    median(r.layer_ns[1]), median(r.layer_ns[2]), median(r.layer_ns[3]), median(r.path_ns));
