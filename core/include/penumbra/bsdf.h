@@ -90,10 +90,9 @@ class Bsdf : public Object {
   /// The dominant lobe for wo (see LobeSummary). The default is a cosine lobe with coefficient 1.
   virtual LobeSummary lobe(const Vec3& wo, const ShadingContext& ctx) const;
 
-  bool is_specular_only() const {
-    uint32_t f = flags();
-    return (f & BsdfSpecular) && !(f & (BsdfDiffuse | BsdfGlossy));
-  }
+  bool is_specular_only() const { return is_specular_only(flags()); }
+  /// The same test on flags already asked for (flags() is a virtual call).
+  static bool is_specular_only(uint32_t f) { return (f & BsdfSpecular) && !(f & (BsdfDiffuse | BsdfGlossy)); }
 };
 
 /// Base of a material whose parameters vary per hit (textures): Derived::at(ctx) builds the BSDF with

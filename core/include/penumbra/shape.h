@@ -16,6 +16,11 @@ struct ShapeSample {
   Vec3 n;  // oriented geometric normal at p
   Vec2 uv;
   float pdf = 0.f;
+  // sample_solid_angle() only (sample_area() leaves them zero): the unit direction from the
+  // context's point to p and the distance between them, which the shape computed for the density;
+  // a light takes them instead of a second square root and division per sample.
+  Vec3 wi{0.f};
+  float distance = 0.f;
 };
 
 /// Where a shape is sampled from: a point, and its surface normal when it lies on a surface.
@@ -42,13 +47,18 @@ class Shape {
   virtual bool present(const ShapeSample&) const { return true; }
 };
 
-/// Converts a per-area density at p_light (normal n_light) to per solid angle at p.
-inline float area_to_solid_angle_pdf(float pdf_area, const Vec3& p, const Vec3& p_light,
-                                     const Vec3& n_light) {
+/// Converts a per-area density at p_light (normal n_light) to per solid angle at p. Where given, wi
+/// and distance receive the unit direction from p to p_light and the distance (set where the
+/// density is not 0), computed on the way.
+inline float area_to_solid_angle_pdf(float pdf_area, const Vec3& p, const Vec3& p_light, const Vec3& n_light,
+                                     Vec3* wi = nullptr, float* distance = nullptr) {
   Vec3 d = p_light - p;
   float dist2 = glm::dot(d, d);
-  float cos_l = std::abs(glm::dot(n_light, d)) / std::sqrt(dist2);
+  float dist = std::sqrt(dist2);
+  float cos_l = std::abs(glm::dot(n_light, d)) / dist;
   if (cos_l == 0.f || dist2 == 0.f) return 0.f;
+  if (wi) *wi = d / dist;
+  if (distance) *distance = dist;
   return pdf_area * dist2 / cos_l;
 }
 

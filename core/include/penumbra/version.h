@@ -26,7 +26,8 @@
 // 12: SampleIntegrator::wavelengths_per_pass(), Pass::wavelengths.
 // 13: CameraWiSample::pdf_pos and pdf_dir.
 // 14: PixelSample::first_hit; PixelIntegrator::Li() takes it, takes_first_hit().
-#define PENUMBRA_SDK_VERSION 14
+// 15: ShapeSample::wi and distance (sample_solid_angle() gives the direction it computed).
+#define PENUMBRA_SDK_VERSION 15
 #endif
 
 #define PENUMBRA_VERSION_STRING "0.1.0"

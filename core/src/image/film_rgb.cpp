@@ -64,6 +64,11 @@ PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const 
     if (!(sigma_ > 0.f)) throw Error(params.loc_of("sigma"), "sigma must be > 0");
     for (int axis = 0; axis < 2; ++axis) {
       gaussian_at_radius_[axis] = std::exp(-radius_[axis] * radius_[axis] / (2.f * sigma_ * sigma_));
+      std::vector<float>& table = gaussian_table_[axis];
+      table.resize(kGaussianIntervals + 1);
+      for (int i = 0; i <= kGaussianIntervals; ++i)
+        table[i] = eval_gaussian(radius_[axis] * (2.f * i / kGaussianIntervals - 1.f), axis);
+      gaussian_scale_[axis] = kGaussianIntervals / (2.f * radius_[axis]);
       const int n = 4096;
       std::vector<float> f(n);
       for (int i = 0; i < n; ++i) f[i] = eval_gaussian(radius_[axis] * (2.f * (i + 0.5f) / n - 1.f), axis);
@@ -83,11 +88,11 @@ PixelFilter::PixelFilter(const std::string& type, const ParamSet& params, const 
       integral_[axis] = 2.f * r;
     } else if (type == "triangle") {
       integral_[axis] = r * r;
-    } else {  // the Gaussian's integral by the midpoint rule (4096 intervals: relative error below 1e-7)
-      const int n = 4096;
-      double sum = 0.0;
-      for (int i = 0; i < n; ++i) sum += eval_gaussian(r * (2.f * (i + 0.5f) / n - 1.f), axis);
-      integral_[axis] = static_cast<float>(sum * 2.0 * r / n);
+    } else {  // the integral of the interpolated table: the trapezoid rule on its knots, exactly
+      const std::vector<float>& table = gaussian_table_[axis];
+      double sum = 0.5 * (table.front() + table.back());
+      for (int i = 1; i < kGaussianIntervals; ++i) sum += table[i];
+      integral_[axis] = static_cast<float>(sum * 2.0 * r / kGaussianIntervals);
     }
   }
 }
@@ -97,7 +102,7 @@ float PixelFilter::evaluate_axis(float x, int axis) const {
   if (!(std::abs(x) < r)) return 0.f;
   if (shape_ == Shape::Box) return 1.f;
   if (shape_ == Shape::Triangle) return r - std::abs(x);
-  return eval_gaussian(x, axis);
+  return gaussian(x, axis);
 }
 
 float PixelFilter::normalized(float x, int axis) const { return evaluate_axis(x, axis) / integral_[axis]; }
@@ -105,6 +110,15 @@ float PixelFilter::normalized(float x, int axis) const { return evaluate_axis(x,
 // The Gaussian shifted down to reach 0 at the radius (its value there is computed once).
 float PixelFilter::eval_gaussian(float x, int axis) const {
   return std::max(0.f, std::exp(-x * x / (2.f * sigma_ * sigma_)) - gaussian_at_radius_[axis]);
+}
+
+// The Gaussian as the film uses it: the table of eval_gaussian() interpolated linearly, for |x| <= radius.
+float PixelFilter::gaussian(float x, int axis) const {
+  const std::vector<float>& table = gaussian_table_[axis];
+  float t = (x + radius_[axis]) * gaussian_scale_[axis];
+  int i = std::clamp(static_cast<int>(t), 0, kGaussianIntervals - 1);
+  float f = t - static_cast<float>(i);
+  return std::max(0.f, table[i] + f * (table[i + 1] - table[i]));
 }
 
 // Samples one axis of the separable filter; `weight` gets f(x)/pdf(x), up to a constant factor that
@@ -125,7 +139,7 @@ float PixelFilter::sample_axis(float u, int axis, float* weight) const {
   float width = inv[k + 1] - inv[k];
   float x = inv[k] + (t - k) * width;
   // pdf(x) = 1 / (kInverseSize * width) on this interval.
-  *weight = eval_gaussian(x, axis) * kInverseSize * width;
+  *weight = gaussian(x, axis) * kInverseSize * width;
   return x;
 }
 

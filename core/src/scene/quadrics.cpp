@@ -1,5 +1,7 @@
 #include "scene/quadrics.h"
 
+#include "scene/shape_sample_direction.h"
+
 #include <cmath>
 
 namespace penumbra {
@@ -72,7 +74,7 @@ ShapeSample Quadric::make_sample(const glm::dvec3& p_object) const {
 // By area, converted to solid angle at ctx.p (as pbrt-v4 does for disks and cylinders).
 std::optional<ShapeSample> Quadric::sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const {
   ShapeSample s = sample_area(u);
-  s.pdf = area_to_solid_angle_pdf(s.pdf, ctx.p, s.p, s.n);
+  area_sample_seen_from(s, ctx.p);
   if (!(s.pdf > 0.f) || std::isinf(s.pdf)) return std::nullopt;
   return s;
 }

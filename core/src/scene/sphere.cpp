@@ -1,5 +1,7 @@
 #include "scene/sphere.h"
 
+#include "scene/shape_sample_direction.h"
+
 #include <penumbra/sampling.h>
 
 namespace penumbra {
@@ -83,7 +85,7 @@ std::optional<ShapeSample> Sphere::sample_solid_angle(const ShapeSampleContext& 
   float dc2 = glm::dot(to_center, to_center);
   if (dc2 <= radius_ * radius_ * 1.0001f) {  // inside (or on) the sphere: sample by area
     ShapeSample s = sample_area(u);
-    s.pdf = area_to_solid_angle_pdf(s.pdf, ctx.p, s.p, s.n);
+    area_sample_seen_from(s, ctx.p);
     if (!(s.pdf > 0.f) || std::isinf(s.pdf)) return std::nullopt;
     return s;
   }
@@ -108,6 +110,7 @@ std::optional<ShapeSample> Sphere::sample_solid_angle(const ShapeSampleContext& 
   Vec3 n_obj = frame.to_world(Vec3(sin_alpha * std::cos(phi), sin_alpha * std::sin(phi), cos_alpha));
   Vec3 p = center_ + radius_ * n_obj;
   ShapeSample s{p, inward_ ? -n_obj : n_obj, uv_at(p), 1.f / (2.f * Pi * one_minus_cos_max)};
+  set_direction_from(s, ctx.p);
   return s;
 }
 

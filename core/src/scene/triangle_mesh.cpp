@@ -1,5 +1,7 @@
 #include "scene/triangle_mesh.h"
 
+#include "scene/shape_sample_direction.h"
+
 #include "util/cpu_clones.h"
 #include "util/triangle_warp.h"
 
@@ -220,6 +222,7 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
     std::optional<ShapeSample> out(std::in_place);
     fill_at(Vec3(1.f - b1 - b2, b1, b2), *out);
     out->pdf = 1.f / omega;
+    set_direction_from(*out, ctx.p);
     return out;
   }
   return sample_by_area(ctx, u);
@@ -230,7 +233,7 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
   std::optional<ShapeSample> out(std::in_place);
   ShapeSample& s = *out;
   area_sample_into(u, s);
-  s.pdf = area_to_solid_angle_pdf(s.pdf, ctx.p, s.p, s.n);
+  area_sample_seen_from(s, ctx.p);
   if (!(s.pdf > 0.f) || std::isinf(s.pdf)) out.reset();
   return out;
 }

@@ -82,6 +82,7 @@ class PathIntegrator final : public PixelIntegrator {
       if (depth == max_depth_) break;
 
       const Bsdf& bsdf = *si->bsdf;
+      const uint32_t flags = bsdf.flags();  // asked once: a virtual call
       Vec3 wo = si->shading.to_local(si->wo);
       ShadingContext sctx{si->texture_context(), TransportMode::Radiance};
       sctx.tex.wavelengths = wavelengths;
@@ -91,14 +92,14 @@ class PathIntegrator final : public PixelIntegrator {
       // its delta samples are told apart below by their own flag (no MIS for what they hit).
       float u_light = sampler.get_1d();
       Vec2 u_light_point = sampler.get_2d();
-      if (light_sampling_ && bsdf.flags() != 0 && !bsdf.is_specular_only())
+      if (light_sampling_ && flags != 0 && !Bsdf::is_specular_only(flags))
         L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point, medium, wavelengths);
 
       // Continue the path by sampling the BSDF.
       float u_lobe = sampler.get_1d();
       Vec2 u_dir = sampler.get_2d();
       float u_rr = sampler.get_1d();
-      std::optional<BsdfSample> bs = bsdf.flags() ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
+      std::optional<BsdfSample> bs = flags ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
       if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
       Vec3 wi = si->shading.to_world(bs->wi);
       // Reject directions that the shading normal calls reflection but the geometry calls

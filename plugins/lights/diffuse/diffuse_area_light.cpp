@@ -30,10 +30,8 @@ class DiffuseAreaLight final : public Light {
     std::optional<LightLiSample> ls;  // returned by name on every path (emplace_li_sample())
     std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, u);
     if (!ss || !(ss->pdf > 0.f) || !shape_->present(*ss)) return ls;
-    Vec3 d = ss->p - ctx.p;
-    float len = glm::length(d);
-    if (len == 0.f) return ls;
-    Vec3 wi = d / len;
+    if (ss->distance == 0.f) return ls;
+    const Vec3& wi = ss->wi;  // the shape's, computed for the density
     Rgb Le = L(ss->p, ss->n, ss->uv, -wi);
     if (is_black(Le)) return ls;
     emplace_li_sample(ls, Le, wi, ss->pdf, ss->p, ss->n);
