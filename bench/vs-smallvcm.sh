@@ -17,9 +17,12 @@
 # matters more to SmallVCM (same section).
 #
 # Usage: bench/vs-smallvcm.sh --smallvcm BIN [--runs N] [--time S] [--threads N] [--algorithms pt,bpt,ppm]
-#                             [--scenes area,point,env] [--pause S] [--keep DIR] [--build DIR]
+#                             [--scenes area,point,env] [--first-seed N] [--pause S] [--keep DIR] [--build DIR]
 #   --smallvcm    the SmallVCM binary (required)
 #   --runs        runs per cell (default 3); Penumbra's seed is the run number, SmallVCM's seeds are fixed
+#   --first-seed  the first run's number (default 1): a batch from --first-seed 101 has seeds no batch
+#                 from 1 with fewer than 101 runs used, so it adds independent samples instead of
+#                 measuring the same images again
 #   --time        seconds of wall time per render (default 10); SmallVCM's -t is processor time summed
 #                 over its threads, so it is given time x threads
 #   --pause       seconds of idle before each render (default 3), so one render's tail does not slow the next
@@ -31,6 +34,7 @@ source "$root/bench/common.sh"
 
 smallvcm=""
 runs=3
+first_seed=1
 time_budget=10
 threads=2
 algorithms=pt,bpt,ppm
@@ -42,6 +46,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --smallvcm) smallvcm="$2"; shift 2 ;;
     --runs) runs="$2"; shift 2 ;;
+    --first-seed) first_seed="$2"; shift 2 ;;
     --time) time_budget="$2"; shift 2 ;;
     --threads) threads="$2"; shift 2 ;;
     --algorithms) algorithms="$2"; shift 2 ;;
@@ -56,7 +61,7 @@ done
 [ -n "$smallvcm" ] || { echo "vs-smallvcm.sh: --smallvcm BIN is required (see --help)" >&2; exit 2; }
 [ -x "$smallvcm" ] || { echo "vs-smallvcm.sh: --smallvcm: '$smallvcm' is not an executable file" >&2; exit 2; }
 smallvcm=$(cd "$(dirname "$smallvcm")" && pwd)/$(basename "$smallvcm")
-for option in runs:"$runs" time:"$time_budget" threads:"$threads"; do
+for option in runs:"$runs" first-seed:"$first_seed" time:"$time_budget" threads:"$threads"; do
   [[ "${option#*:}" =~ ^[1-9][0-9]*$ ]] || { echo "vs-smallvcm.sh: --${option%%:*} must be a positive integer" >&2; exit 2; }
 done
 [[ "$pause" =~ ^[0-9]+$ ]] || { echo "vs-smallvcm.sh: --pause must be a whole number of seconds" >&2; exit 2; }
@@ -76,14 +81,14 @@ done
 bench_work_dir "$keep" penumbra-vs-smallvcm
 csv="$work/renders.csv"
 echo "renderer,scene,algorithm,run,passes,seconds,relmse,load" > "$csv"
-echo "vs-smallvcm.sh: $runs runs x scenes $scenes x $algorithms, ${time_budget} s, $threads threads;" \
+echo "vs-smallvcm.sh: $runs runs (seeds $first_seed-$((first_seed + runs - 1))) x scenes $scenes x $algorithms, ${time_budget} s, $threads threads;" \
   "Penumbra $(bench_commit "$root") ($(bench_build_arch "$build") build)" >&2
 
 relmse_of() {  # image, reference
   "$build/bin/penumbra-bench-image-errors" "$1" "$2" | "$py" -c "import json, sys; print(json.load(sys.stdin)['relmse'])"
 }
 
-for ((run = 1; run <= runs; ++run)); do
+for ((run = first_seed; run < first_seed + runs; ++run)); do
   for s in ${scenes//,/ }; do
     scene_file="$root/scenes/bench/cornell-spheres-$s.pbrt"
     ref="$root/bench/references/cornell-spheres-$s.exr"
