@@ -20,9 +20,9 @@
 #                             [--scenes area,point,env] [--first-seed N] [--pause S] [--keep DIR] [--build DIR]
 #   --smallvcm    the SmallVCM binary (required)
 #   --runs        runs per cell (default 3); Penumbra's seed is the run number, SmallVCM's seeds are fixed
-#   --first-seed  the first run's number (default 1): a batch from --first-seed 101 has seeds no batch
-#                 from 1 with fewer than 101 runs used, so it adds independent samples instead of
-#                 measuring the same images again
+#   --first-seed  the first run's number (default 1): the seeds are N to N + runs - 1, so a batch that
+#                 starts past an earlier batch's last seed adds independent samples instead of
+#                 rendering the same images again
 #   --time        seconds of wall time per render (default 10); SmallVCM's -t is processor time summed
 #                 over its threads, so it is given time x threads
 #   --pause       seconds of idle before each render (default 3), so one render's tail does not slow the next
