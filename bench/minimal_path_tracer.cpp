@@ -77,6 +77,8 @@ MinimalPathTracer::MinimalPathTracer(const EmbreeScene& scene, int max_depth, in
 
 template <unsigned kLayers>
 Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed, uint64_t* rays) const {
+  // Layers stack in order (render() builds 0, 1, 3 and 7): Light::pdf_li() reads the hit record.
+  static_assert((kLayers & kLights) == 0 || (kLayers & kHits) != 0, "kLights needs kHits");
   Pcg32 rng(stream, seed);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
@@ -123,13 +125,7 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
         float light_pdf;
         if constexpr ((kLayers & kLights) != 0) {
           const Light* light = tri_lights_[index];
-          if constexpr ((kLayers & kHits) != 0) {
-            light_pdf = scene_.light_pmf(light) * light->pdf_li(prev, ray.d, *si);
-          } else {
-            SurfaceInteraction hit;
-            hit.p = p, hit.ng = tri.n;
-            light_pdf = scene_.light_pmf(light) * light->pdf_li(prev, ray.d, hit);
-          }
+          light_pdf = scene_.light_pmf(light) * light->pdf_li(prev, ray.d, *si);
         } else {
           float dist2 = t * t * glm::dot(ray.d, ray.d);
           light_pdf = emitter_pmf_[index] * dist2 * glm::length(ray.d) / (std::abs(cos_o) * tri.area);
