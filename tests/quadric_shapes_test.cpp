@@ -9,6 +9,7 @@
 #include "scene/quadrics.h"
 #include "scene/scene_builder.h"
 #include "support/chi_square.h"
+#include "support/shape_sample_checks.h"
 #include "support/command.h"
 #include "support/image_stats.h"
 #include "support/pcg32.h"
@@ -162,9 +163,11 @@ namespace {
 // point of the shape along it (a ray can cross a cylinder twice), found with the shape's intersect().
 ChiSquareResult test_solid_angle_sampling(const Quadric& q, const Vec3& ref, double pdf_scale = 1.0) {
   ShapeSampleContext ctx{ref, Vec3(0.f)};
+  int mismatched = 0;
   auto sample = [&](Vec2 u, float) -> std::optional<Vec3> {
     auto s = q.sample_solid_angle(ctx, u);
     if (!s) return std::nullopt;
+    mismatched += !direction_fields_match(*s, ref);
     return glm::normalize(s->p - ref);
   };
   auto pdf = [&](const Vec3& w) -> double {
@@ -180,7 +183,9 @@ ChiSquareResult test_solid_angle_sampling(const Quadric& q, const Vec3& ref, dou
     return pdf_scale * sum;
   };
   SphereChart chart;  // the default 6 levels of refinement find the shapes' edges inside cells
-  return chi_square_sphere(sample, pdf, 1000000, 40, 80, 23, chart);
+  ChiSquareResult r = chi_square_sphere(sample, pdf, 1000000, 40, 80, 23, chart);
+  EXPECT_EQ(mismatched, 0) << "samples whose wi or distance does not match their point (ShapeSample)";
+  return r;
 }
 
 }  // namespace

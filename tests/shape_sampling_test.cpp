@@ -1,9 +1,11 @@
 // Solid-angle sampling of the shapes area lights use, against their own pdfs by chi-square: spheres
 // seen from outside (cone sampling, including the Taylor branch for cones under 1.5 degrees) and from
-// inside (area sampling), and triangles (area sampling converted to solid angle).
+// inside (area sampling), and triangles (area sampling converted to solid angle). Every sample's
+// direction and distance fields must match its point (direction_fields_match()).
 #include "scene/sphere.h"
 #include "scene/triangle_mesh.h"
 #include "support/chi_square.h"
+#include "support/shape_sample_checks.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -30,9 +32,11 @@ std::optional<Vec3> hit_sphere(const Sphere& s, const Vec3& o, const Vec3& w) {
 
 ChiSquareResult test_sphere(const Sphere& sphere, const Vec3& ref, double z_min) {
   ShapeSampleContext ctx{ref, Vec3(0.f)};
+  int mismatched = 0;
   auto sample = [&](Vec2 u, float) -> std::optional<Vec3> {
     auto s = sphere.sample_solid_angle(ctx, u);
     if (!s) return std::nullopt;
+    mismatched += !direction_fields_match(*s, ref);
     return glm::normalize(s->p - ref);
   };
   auto pdf = [&](const Vec3& w) -> double {
@@ -41,7 +45,9 @@ ChiSquareResult test_sphere(const Sphere& sphere, const Vec3& ref, double z_min)
   };
   SphereChart chart;
   chart.z_min = z_min;
-  return chi_square_sphere(sample, pdf, 1000000, 40, 80, 17, chart);
+  ChiSquareResult r = chi_square_sphere(sample, pdf, 1000000, 40, 80, 17, chart);
+  EXPECT_EQ(mismatched, 0) << "samples whose wi or distance does not match their point";
+  return r;
 }
 
 }  // namespace
@@ -84,9 +90,11 @@ namespace {
 ChiSquareResult triangle_chi_square(const TriangleMesh& mesh, double z_min) {
   Triangle tri(&mesh, 0);
   ShapeSampleContext ctx{Vec3(0.f), Vec3(0.f)};
+  int mismatched = 0;
   auto sample = [&](Vec2 u, float) -> std::optional<Vec3> {
     auto s = tri.sample_solid_angle(ctx, u);
     if (!s) return std::nullopt;
+    mismatched += !direction_fields_match(*s, ctx.p);
     return glm::normalize(s->p);
   };
   // Ray-plane intersection and inside test in double precision.
@@ -105,7 +113,9 @@ ChiSquareResult triangle_chi_square(const TriangleMesh& mesh, double z_min) {
   };
   SphereChart chart;
   chart.z_min = z_min;
-  return chi_square_sphere(sample, pdf, 1000000, 40, 80, 23, chart);
+  ChiSquareResult r = chi_square_sphere(sample, pdf, 1000000, 40, 80, 23, chart);
+  EXPECT_EQ(mismatched, 0) << "samples whose wi or distance does not match their point";
+  return r;
 }
 
 }  // namespace
@@ -139,4 +149,22 @@ TEST(TriangleSampling, ModerateTriangleUsesAreaSamplingChiSquare) {
   ChiSquareResult r = triangle_chi_square(mesh, std::cos(0.3));
   EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
   EXPECT_NEAR(r.pdf_integral, 1.0, 3e-3);
+}
+
+// The check the chi-square tests apply to every sample: it accepts a sample whose fields match and
+// rejects the two ways a producer could get them wrong (fields left at zero, a distance 1 % off).
+TEST(ShapeSampleFields, CheckRejectsMissingOrWrongFields) {
+  Vec3 ref(0.5f, -1.f, 2.f);
+  ShapeSample s;
+  s.p = Vec3(1.f, 2.f, 3.f);
+  s.distance = glm::length(s.p - ref);
+  s.wi = (s.p - ref) / s.distance;
+  EXPECT_TRUE(direction_fields_match(s, ref));
+  ShapeSample unset = s;
+  unset.wi = Vec3(0.f);
+  unset.distance = 0.f;
+  EXPECT_FALSE(direction_fields_match(unset, ref));
+  ShapeSample far = s;
+  far.distance *= 1.01f;
+  EXPECT_FALSE(direction_fields_match(far, ref));
 }
