@@ -64,7 +64,7 @@ constexpr float error_gamma(int n) {
 /// Error bound of a point known only by its coordinates (a light sample, a point handed to the SDK):
 /// that of a barycentric interpolation of vertices of its own magnitude, plus a tiny absolute floor
 /// for points near the origin.
-inline Vec3 point_error_bound(const Vec3& p) { return error_gamma(7) * glm::abs(p) + Vec3(1e-7f); }
+inline Vec3 point_error_bound(const Vec3& p) { return error_gamma(7) * abs_each(p) + Vec3(1e-7f); }
 
 /// The next float above (below) v, for finite v (pbrt's NextFloatUp/Down; std::nextafter is a libm
 /// call several times slower, and this runs six times per spawned ray).
@@ -86,7 +86,7 @@ inline float next_float_down(float v) {
 /// Moves `p` (absolute error at most p_error per component) off a surface with geometric normal `n`
 /// towards the side `w` points to: past the error box along n, each coordinate rounded away.
 inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, Vec3 n, const Vec3& w) {
-  float d = glm::dot(glm::abs(n), p_error);
+  float d = glm::dot(abs_each(n), p_error);
   Vec3 offset = d * n;
   if (glm::dot(w, n) < 0.f) offset = -offset;
   Vec3 po = p + offset;

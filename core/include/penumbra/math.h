@@ -30,6 +30,9 @@ inline float safe_sqrt(float x) { return std::sqrt(std::max(0.f, x)); }
 inline float radians(float deg) { return deg * (Pi / 180.f); }
 inline bool is_finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 inline float max_component(const Vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+/// |v| per component by clearing the sign bits. glm::abs computes x >= 0 ? x : -x, which keeps the
+/// sign of -0 and so compiles to a compare and a blend per component.
+inline Vec3 abs_each(const Vec3& v) { return Vec3(std::abs(v.x), std::abs(v.y), std::abs(v.z)); }
 
 /// Orthonormal basis around a unit normal (Duff et al. 2017, branchless).
 struct Frame {

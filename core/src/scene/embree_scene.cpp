@@ -437,7 +437,6 @@ void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceIn
   // A hit inside an instance is computed in the prototype's space and then placed.
   const Instance* inst = hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[hit.instID[0]] : nullptr;
   const Geometry& g = inst ? prototypes_[inst->prototype].geometries[hit.geomID] : geometries_[hit.geomID];
-  Ray local = inst ? Ray{Vec3(inst->to_object * Vec4(ray.o, 1.f)), glm::mat3(inst->to_object) * ray.d, ray.tmax} : ray;
   si.t = t;
   si.wo = -glm::normalize(ray.d);
   si.shape_id = inst ? hit.instID[0] : hit.geomID;
@@ -445,6 +444,12 @@ void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceIn
   si.bsdf = g.bsdf;
   si.media = g.media;
   if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? hit.primID : 0];
+  if (g.mesh && !inst && !g.tangent_frame) {  // the common case, without the general one's locals
+    g.mesh->surface_into(hit.primID, Vec3(1.f - hit.u - hit.v, hit.u, hit.v), si);
+    si.shading = Frame(si.ns);
+    return;
+  }
+  Ray local = inst ? Ray{Vec3(inst->to_object * Vec4(ray.o, 1.f)), glm::mat3(inst->to_object) * ray.d, ray.tmax} : ray;
   Vec3 dpdu(0.f), dpdv(0.f);  // for tangent frames and texture footprints only
   if (g.mesh) {
     // The hit point comes from the barycentrics: its error does not grow with t.
@@ -476,7 +481,7 @@ void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceIn
     si.uv = s.uv;
   } else {
     si.p = g.sphere->reproject(local.o + si.t * local.d);
-    si.p_error = error_gamma(5) * glm::abs(si.p);
+    si.p_error = error_gamma(5) * abs_each(si.p);
     si.ng = si.ns = g.sphere->normal_at(si.p);
     si.uv = g.sphere->uv_at(si.p);
     if (g.tangent_frame) g.sphere->uv_derivatives(si.p, &dpdu, &dpdv);

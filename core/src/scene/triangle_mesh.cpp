@@ -20,7 +20,7 @@ Vec3 TriangleMesh::position(size_t i, const Vec3& b) const {
 
 Vec3 TriangleMesh::position_error(size_t i, const Vec3& b) const {
   const uint32_t* v = &indices[3 * i];
-  return error_gamma(7) * (glm::abs(b.x * P[v[0]]) + glm::abs(b.y * P[v[1]]) + glm::abs(b.z * P[v[2]]));
+  return error_gamma(7) * (abs_each(b.x * P[v[0]]) + abs_each(b.y * P[v[1]]) + abs_each(b.z * P[v[2]]));
 }
 
 Vec3 TriangleMesh::shading_normal(size_t i, const Vec3& b) const {
@@ -55,12 +55,14 @@ Vec3 TriangleMesh::geometric_normal(size_t i, const Vec3& b) const {
   return oriented(face_normal(i), shading_normal(i, b));
 }
 
-PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
+// One body for surface() and surface_into(): `out` has members p, p_error, ng, ns and uv.
+template <typename Out>
+[[gnu::always_inline]] inline void TriangleMesh::surface_at(size_t i, const Vec3& b_in, Out& out) const {
+  const Vec3 b = b_in;  // a local: stores into `out` could otherwise alias it and force reloads
   const uint32_t* v = &indices[3 * i];
   const Vec3 &p0 = P[v[0]], &p1 = P[v[1]], &p2 = P[v[2]];
-  Surface s;
-  s.p = b.x * p0 + b.y * p1 + b.z * p2;
-  s.p_error = error_gamma(7) * (glm::abs(b.x * p0) + glm::abs(b.y * p1) + glm::abs(b.z * p2));
+  out.p = b.x * p0 + b.y * p1 + b.z * p2;
+  out.p_error = error_gamma(7) * (abs_each(b.x * p0) + abs_each(b.y * p1) + abs_each(b.z * p2));
   Vec3 ns(0.f);
   if (!N.empty()) {
     Vec3 n = b.x * N[v[0]] + b.y * N[v[1]] + b.z * N[v[2]];
@@ -71,13 +73,22 @@ PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, 
   // (39 instructions per hit on the Cornell box).
   Vec3 fn = i < face_normals.size() ? face_normals[i] : face_normal(i);
   if (ns == Vec3(0.f)) {
-    s.ng = s.ns = flip_normal ? -fn : fn;
+    out.ng = out.ns = flip_normal ? -fn : fn;
   } else {
-    s.ng = glm::dot(fn, ns) < 0.f ? -fn : fn;
-    s.ns = ns;
+    out.ng = glm::dot(fn, ns) < 0.f ? -fn : fn;
+    out.ns = ns;
   }
-  s.uv = uv.empty() ? Vec2(b.y + b.z, b.z) : b.x * uv[v[0]] + b.y * uv[v[1]] + b.z * uv[v[2]];
+  out.uv = uv.empty() ? Vec2(b.y + b.z, b.z) : b.x * uv[v[0]] + b.y * uv[v[1]] + b.z * uv[v[2]];
+}
+
+PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
+  Surface s;
+  surface_at(i, b, s);
   return s;
+}
+
+PENUMBRA_X86_64_V3_CLONES void TriangleMesh::surface_into(size_t i, const Vec3& b, SurfaceInteraction& si) const {
+  surface_at(i, b, si);
 }
 
 void TriangleMesh::uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const {

@@ -7,6 +7,8 @@
 
 namespace penumbra {
 
+struct SurfaceInteraction;
+
 struct TriangleMesh {
   std::vector<Vec3> P;       // world-space positions
   std::vector<Vec3> N;       // world-space shading normals (optional), already flipped by ReverseOrientation
@@ -35,11 +37,15 @@ struct TriangleMesh {
     Vec2 uv;
   };
   Surface surface(size_t i, const Vec3& b) const;
+  /// surface() written straight into a hit record's p, p_error, ng, ns and uv.
+  void surface_into(size_t i, const Vec3& b, SurfaceInteraction& si) const;
   /// dp/du and dp/dv of triangle i (constant over it); for a degenerate uv mapping, two axes
   /// perpendicular to the face normal.
   void uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const;
 
  private:
+  template <typename Out>
+  void surface_at(size_t i, const Vec3& b, Out& out) const;
   Vec3 face_normal(size_t i) const;
   Vec3 oriented(const Vec3& n, const Vec3& ns) const;
 };
