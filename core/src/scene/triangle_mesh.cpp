@@ -242,11 +242,21 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
 [[gnu::always_inline]] inline std::optional<ShapeSample> Triangle::sample_by_area(const ShapeSampleContext& ctx,
                                                                               Vec2 u) const {
   std::optional<ShapeSample> out(std::in_place);
-  ShapeSample& s = *out;
-  area_sample_into(u, s);
-  area_sample_seen_from(s, ctx.p);
-  if (!(s.pdf > 0.f) || std::isinf(s.pdf)) out.reset();
+  if (!sample_area_seen_from(ctx.p, u, *out)) out.reset();
   return out;
+}
+
+// area_sample_into() and the free area_sample_seen_from() in one function, compiled for x86-64-v3 too: nearly
+// every light sample on a triangle takes this branch, and the baseline's scalar SSE code for it was
+// about 230 instructions.
+PENUMBRA_X86_64_V3_CLONES bool Triangle::sample_area_seen_from(const Vec3& ref, Vec2 u, ShapeSample& s) const {
+  Vec2 b12 = uniform_triangle_barycentrics(u);
+  Vec3 b(1.f - b12.x - b12.y, b12.x, b12.y);
+  s.p = b.x * p_[0] + b.y * p_[1] + b.z * p_[2];
+  s.n = n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, b);
+  s.uv = b.x * uv_[0] + b.y * uv_[1] + b.z * uv_[2];
+  s.pdf = area_to_solid_angle_pdf(inv_area_, ref, s.p, s.n, &s.wi, &s.distance);
+  return s.pdf > 0.f && !std::isinf(s.pdf);
 }
 
 float Triangle::pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,

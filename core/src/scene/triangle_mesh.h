@@ -63,6 +63,9 @@ class Triangle final : public Shape {
   bool spherical_worthwhile(const Vec3& p) const;
   std::optional<ShapeSample> sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const;
   void area_sample_into(Vec2 u, ShapeSample& s) const;
+  /// A sample uniform in area and its density per solid angle, direction and distance seen from
+  /// `ref`; false where that density is zero or infinite.
+  bool sample_area_seen_from(const Vec3& ref, Vec2 u, ShapeSample& s) const;
   /// Point, oriented normal and uv at barycentrics b, from the copies below.
   void fill_at(const Vec3& b, ShapeSample& s) const;
   const TriangleMesh* mesh_;
