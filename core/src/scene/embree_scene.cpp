@@ -445,7 +445,7 @@ void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceIn
   si.media = g.media;
   if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? hit.primID : 0];
   if (g.mesh && !inst && !g.tangent_frame) {  // the common case, without the general one's locals
-    g.mesh->surface_into(hit.primID, Vec3(1.f - hit.u - hit.v, hit.u, hit.v), si);
+    g.mesh->surface_into(hit.primID, Vec3(1.f - hit.u - hit.v, hit.u, hit.v), Vec3(hit.Ng_x, hit.Ng_y, hit.Ng_z), si);
     si.shading = Frame(si.ns);
     return;
   }

@@ -55,9 +55,10 @@ Vec3 TriangleMesh::geometric_normal(size_t i, const Vec3& b) const {
   return oriented(face_normal(i), shading_normal(i, b));
 }
 
-// One body for surface() and surface_into(): `out` has members p, p_error, ng, ns and uv.
+// One body for surface() and surface_into(): `out` has members p, p_error, ng, ns and uv; fn is the
+// triangle's unit face normal by the winding.
 template <typename Out>
-[[gnu::always_inline]] inline void TriangleMesh::surface_at(size_t i, const Vec3& b_in, Out& out) const {
+[[gnu::always_inline]] inline void TriangleMesh::surface_at(size_t i, const Vec3& b_in, const Vec3& fn, Out& out) const {
   const Vec3 b = b_in;  // a local: stores into `out` could otherwise alias it and force reloads
   const uint32_t* v = &indices[3 * i];
   const Vec3 &p0 = P[v[0]], &p1 = P[v[1]], &p2 = P[v[2]];
@@ -69,9 +70,7 @@ template <typename Out>
     float len2 = glm::dot(n, n);
     if (len2 > 0.f) ns = n / std::sqrt(len2);
   }
-  // face_normal() and oriented() written out: this x86-64-v3 clone called both out of line
-  // (39 instructions per hit on the Cornell box).
-  Vec3 fn = i < face_normals.size() ? face_normals[i] : face_normal(i);
+  // oriented() written out: this x86-64-v3 clone called it out of line.
   if (ns == Vec3(0.f)) {
     out.ng = out.ns = flip_normal ? -fn : fn;
   } else {
@@ -83,12 +82,16 @@ template <typename Out>
 
 PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
   Surface s;
-  surface_at(i, b, s);
+  surface_at(i, b, i < face_normals.size() ? face_normals[i] : face_normal(i), s);
   return s;
 }
 
-PENUMBRA_X86_64_V3_CLONES void TriangleMesh::surface_into(size_t i, const Vec3& b, SurfaceInteraction& si) const {
-  surface_at(i, b, si);
+// The face normal from Embree's: the same cross product of two edges (by the same winding, so the
+// same sign), rounded differently in its last bits, and no read of face_normals[i], a cache miss on a
+// large mesh.
+PENUMBRA_X86_64_V3_CLONES void TriangleMesh::surface_into(size_t i, const Vec3& b, const Vec3& embree_ng,
+                                                          SurfaceInteraction& si) const {
+  surface_at(i, b, glm::normalize(embree_ng), si);
 }
 
 void TriangleMesh::uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const {

@@ -37,15 +37,16 @@ struct TriangleMesh {
     Vec2 uv;
   };
   Surface surface(size_t i, const Vec3& b) const;
-  /// surface() written straight into a hit record's p, p_error, ng, ns and uv.
-  void surface_into(size_t i, const Vec3& b, SurfaceInteraction& si) const;
+  /// surface() written straight into a hit record's p, p_error, ng, ns and uv, with the face normal
+  /// from the unnormalised one Embree reports for the hit (RTCHit::Ng).
+  void surface_into(size_t i, const Vec3& b, const Vec3& embree_ng, SurfaceInteraction& si) const;
   /// dp/du and dp/dv of triangle i (constant over it); for a degenerate uv mapping, two axes
   /// perpendicular to the face normal.
   void uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const;
 
  private:
   template <typename Out>
-  void surface_at(size_t i, const Vec3& b, Out& out) const;
+  void surface_at(size_t i, const Vec3& b, const Vec3& fn, Out& out) const;
   Vec3 face_normal(size_t i) const;
   Vec3 oriented(const Vec3& n, const Vec3& ns) const;
 };
