@@ -62,6 +62,8 @@ class Triangle final : public Shape {
 
  private:
   bool spherical_worthwhile(const Vec3& p) const;
+  /// sample_solid_angle() where spherical_worthwhile(): by solid angle where that is numerically safe.
+  std::optional<ShapeSample> sample_spherical(const ShapeSampleContext& ctx, Vec2 u) const;
   std::optional<ShapeSample> sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const;
   void area_sample_into(Vec2 u, ShapeSample& s) const;
   /// A sample uniform in area and its density per solid angle, direction and distance seen from
