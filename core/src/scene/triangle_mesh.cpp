@@ -55,16 +55,18 @@ Vec3 TriangleMesh::geometric_normal(size_t i, const Vec3& b) const {
   return oriented(face_normal(i), shading_normal(i, b));
 }
 
-// One body for surface() and surface_into(): `out` has members p, p_error, ng, ns and uv; fn is the
-// triangle's unit face normal by the winding.
-template <typename Out>
-[[gnu::always_inline]] inline void TriangleMesh::surface_at(size_t i, const Vec3& b_in, const Vec3& fn,
-                                                          Out& out) const {
-  const Vec3 b = b_in;  // a local: stores into `out` could otherwise alias it and force reloads
+// The hit's point, error bound, normals and uv straight into the record. The face normal is Embree's
+// for the hit (object space, so the prototype's for an instance): the same cross product of two edges
+// by the same winding, so the same sign, rounded differently in its last bits, and no read of
+// face_normals[i], a cache miss on a large mesh.
+PENUMBRA_X86_64_V3_CLONES void TriangleMesh::surface(size_t i, const Vec3& b_in, const Vec3& embree_ng,
+                                                     SurfaceInteraction& si) const {
+  const Vec3 b = b_in;  // a local: stores into `si` could otherwise alias it and force reloads
+  const Vec3 fn = glm::normalize(embree_ng);
   const uint32_t* v = &indices[3 * i];
   const Vec3 &p0 = P[v[0]], &p1 = P[v[1]], &p2 = P[v[2]];
-  out.p = b.x * p0 + b.y * p1 + b.z * p2;
-  out.p_error = error_gamma(7) * (abs_each(b.x * p0) + abs_each(b.y * p1) + abs_each(b.z * p2));
+  si.p = b.x * p0 + b.y * p1 + b.z * p2;
+  si.p_error = error_gamma(7) * (abs_each(b.x * p0) + abs_each(b.y * p1) + abs_each(b.z * p2));
   Vec3 ns(0.f);
   if (!N.empty()) {
     Vec3 n = b.x * N[v[0]] + b.y * N[v[1]] + b.z * N[v[2]];
@@ -73,26 +75,12 @@ template <typename Out>
   }
   // oriented() written out: this x86-64-v3 clone called it out of line.
   if (ns == Vec3(0.f)) {
-    out.ng = out.ns = flip_normal ? -fn : fn;
+    si.ng = si.ns = flip_normal ? -fn : fn;
   } else {
-    out.ng = glm::dot(fn, ns) < 0.f ? -fn : fn;
-    out.ns = ns;
+    si.ng = glm::dot(fn, ns) < 0.f ? -fn : fn;
+    si.ns = ns;
   }
-  out.uv = uv.empty() ? Vec2(b.y + b.z, b.z) : b.x * uv[v[0]] + b.y * uv[v[1]] + b.z * uv[v[2]];
-}
-
-PENUMBRA_X86_64_V3_CLONES TriangleMesh::Surface TriangleMesh::surface(size_t i, const Vec3& b) const {
-  Surface s;
-  surface_at(i, b, i < face_normals.size() ? face_normals[i] : face_normal(i), s);
-  return s;
-}
-
-// The face normal from Embree's: the same cross product of two edges (by the same winding, so the
-// same sign), rounded differently in its last bits, and no read of face_normals[i], a cache miss on a
-// large mesh.
-PENUMBRA_X86_64_V3_CLONES void TriangleMesh::surface_into(size_t i, const Vec3& b, const Vec3& embree_ng,
-                                                          SurfaceInteraction& si) const {
-  surface_at(i, b, glm::normalize(embree_ng), si);
+  si.uv = uv.empty() ? Vec2(b.y + b.z, b.z) : b.x * uv[v[0]] + b.y * uv[v[1]] + b.z * uv[v[2]];
 }
 
 void TriangleMesh::uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const {
@@ -133,9 +121,9 @@ ShapeSample Triangle::sample_area(Vec2 u) const {
 
 // Samples are written field by field into the object the caller returns: built whole and copied
 // out of an std::optional, they stalled store forwarding (docs/benchmarks.md, "Results built in place").
-// This, area_sample_into() and sample_by_area() are inlined into sample_solid_angle(), which every
-// light sample on a triangle goes through: out of line they were three calls deep, each result a
-// round trip through memory.
+// This and area_sample_into() are inlined into sample_area_seen_from(), which nearly every light
+// sample on a triangle goes through: out of line they were three calls deep, each result a round
+// trip through memory.
 [[gnu::always_inline]] inline void Triangle::fill_at(const Vec3& b, ShapeSample& s) const {
   s.p = b.x * p_[0] + b.y * p_[1] + b.z * p_[2];
   s.n = n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, b);
@@ -260,12 +248,8 @@ std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext
 // too: nearly every light sample on a triangle takes this branch, and the baseline's scalar SSE code
 // for it (with sample_solid_angle()'s share) was about 230 instructions.
 PENUMBRA_X86_64_V3_CLONES bool Triangle::sample_area_seen_from(const Vec3& ref, Vec2 u, ShapeSample& s) const {
-  Vec2 b12 = uniform_triangle_barycentrics(u);
-  Vec3 b(1.f - b12.x - b12.y, b12.x, b12.y);
-  s.p = b.x * p_[0] + b.y * p_[1] + b.z * p_[2];
-  s.n = n_flat_ != Vec3(0.f) ? n_flat_ : mesh_->geometric_normal(index_, b);
-  s.uv = b.x * uv_[0] + b.y * uv_[1] + b.z * uv_[2];
-  s.pdf = area_to_solid_angle_pdf(inv_area_, ref, s.p, s.n, &s.wi, &s.distance);
+  area_sample_into(u, s);
+  area_sample_seen_from(s, ref);
   return s.pdf > 0.f && !std::isinf(s.pdf);
 }
 

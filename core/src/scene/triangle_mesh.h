@@ -31,22 +31,15 @@ struct TriangleMesh {
   Vec3 position_error(size_t i, const Vec3& b) const;
   float area(size_t i) const;
 
-  /// Everything a hit at barycentrics b of triangle i needs, with the vertex indices read once.
-  struct Surface {
-    Vec3 p, p_error, ng, ns;  // ns: the interpolated N, or ng without N
-    Vec2 uv;
-  };
-  Surface surface(size_t i, const Vec3& b) const;
-  /// surface() written straight into a hit record's p, p_error, ng, ns and uv, with the face normal
-  /// from the unnormalised one Embree reports for the hit (RTCHit::Ng).
-  void surface_into(size_t i, const Vec3& b, const Vec3& embree_ng, SurfaceInteraction& si) const;
+  /// What a hit at barycentrics b of triangle i needs (point, error bound, oriented geometric and
+  /// shading normals, uv), written into si; embree_ng is the unnormalised normal Embree reports for
+  /// the hit (RTCHit::Ng).
+  void surface(size_t i, const Vec3& b, const Vec3& embree_ng, SurfaceInteraction& si) const;
   /// dp/du and dp/dv of triangle i (constant over it); for a degenerate uv mapping, two axes
   /// perpendicular to the face normal.
   void uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const;
 
  private:
-  template <typename Out>
-  void surface_at(size_t i, const Vec3& b, const Vec3& fn, Out& out) const;
   Vec3 face_normal(size_t i) const;
   Vec3 oriented(const Vec3& n, const Vec3& ns) const;
 };
