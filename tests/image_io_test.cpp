@@ -307,11 +307,54 @@ TEST_F(ImageIo, ExrHeaderClaimingHugeAttributeIsRefusedWithoutAllocatingIt) {
 }
 
 TEST_F(ImageIo, TruncatedFileClaimingLargeImageFailsBeforeAllocatingIt) {
-  // 16000 x 16000 floats (2.9 GiB as RGB) claimed over 64 KiB of data: under the pixel limit, so the
-  // header is believed, but the reader grows its buffer only with the rows it decodes.
-  std::ofstream(path("large.pfm"), std::ios::binary) << "PF\n16000 16000\n-1.0\n" << std::string(65536, '\0');
+  // 16384 x 8192 floats (1.5 GiB as RGB, the largest image read) claimed over 512 KiB of data (more
+  // than 1/4096 of it): the header is believed, but the reader fills its buffer only with the rows
+  // it decodes.
+  std::ofstream(path("large.pfm"), std::ios::binary) << "PF\n16384 8192\n-1.0\n" << std::string(524288, '\0');
   double grown = growth_refusing(path("large.pfm"), path("warm.pfm"));
-  EXPECT_LT(grown, 256.0) << "peak memory grew by " << grown << " MiB reading a 64 KiB file";
+  EXPECT_LT(grown, 256.0) << "peak memory grew by " << grown << " MiB reading a 512 KiB file";
+  EXPECT_EQ(error_of([&] { read_image(path("large.pfm")); }).find("its header claims"), std::string::npos);
+}
+
+// The bytes of a 20 x 12 ZIP-compressed OpenEXR file (one chunk of 16 rows holds all 12) whose data
+// window is then widened to `width` columns, as a fuzzer's mutation did: the header stays consistent
+// (still one chunk), the chunk's data is far too short.
+std::string exr_widened_to(const std::string& file, int width) {
+  ImageRgb img{20, 12, std::vector<float>(20 * 12 * 3, 0.5f)};
+  write_image(file, img);
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key("dataWindow\0box2i\0", 17);
+  size_t at = bytes.find(key);
+  if (at == std::string::npos) return "";
+  size_t xmax = at + key.size() + 4 + 8;  // after the size field and xMin, yMin
+  for (int i = 0; i < 4; ++i) bytes[xmax + i] = char(((width - 1) >> (8 * i)) & 0xff);
+  return bytes;
+}
+
+TEST_F(ImageIo, ExrClaimingAWideImageIsRefusedOrFailsWithoutAllocatingIt) {
+  // Found by scripts/fuzz.sh image in CI (6 Dec): 18175319 x 12 float RGB is 2.6 GB, which the reader
+  // allocated at once (a band of 64 rows held the whole image). Now refused from the header.
+  std::string wide = exr_widened_to(path("wide.exr"), 18175319);
+  ASSERT_FALSE(wide.empty());
+  std::ofstream(path("wide.exr"), std::ios::binary) << wide;
+  std::string message = error_of([&] { read_image(path("wide.exr")); });
+  EXPECT_NE(message.find("wide.exr': 18175319x12 pixels with 3 channels is outside what Penumbra reads"),
+            std::string::npos)
+      << message;
+  // Under those limits (8,000,000 x 12: 1.1 GB as RGB floats) the header is believed, but 1.1 GB of
+  // pixels from a 2.6 KB file is more than any codec compresses: refused before a decoder allocates
+  // its chunk (which peaked at 2.2 GB under scripts/fuzz.sh).
+  std::string believed = exr_widened_to(path("believed.exr"), 8000000);
+  std::ofstream(path("believed.exr"), std::ios::binary) << believed;
+  double grown = growth_refusing(path("believed.exr"), path("warm.exr"));
+  EXPECT_LT(grown, 64.0) << "peak memory grew by " << grown << " MiB reading a " << believed.size() << "-byte file";
+  message = error_of([&] { read_image(path("believed.exr")); });
+  EXPECT_NE(message.find("believed.exr': its header claims 1099 MiB of pixel data (8000000x12 pixels, 3 channels)"),
+            std::string::npos)
+      << message;
+  // Control: the same file, not widened, reads.
+  EXPECT_EQ(read_image(path("warm.exr")).width, gradient().width);
 }
 
 // A 37 x 150 image with distinct pixels: more rows than one read band (64) and a width that is not a
