@@ -44,12 +44,14 @@ std::unique_ptr<Sphere> sphere(Vec3 c, float r) {
 // Two overlapping spheres and one that the partition wall cuts, all inside the closed box. `extra`
 // spheres more, tiny and far outside the box where rays do not reach them, push the count past
 // what is tested outside Embree.
-void build(EmbreeScene& scene, int extra) {
+// With `fourth`, a fourth sphere in the box fills every lane of the scene's pre-test of them all.
+void build(EmbreeScene& scene, int extra, bool fourth = false) {
   scene.add_mesh(box(), nullptr, {});
   scene.add_mesh(partition(), nullptr, {});
   scene.add_sphere(sphere(Vec3(-0.35f, -0.3f, -0.5f), 0.4f), nullptr, nullptr);
   scene.add_sphere(sphere(Vec3(0.f, -0.2f, -0.4f), 0.3f), nullptr, nullptr);
   scene.add_sphere(sphere(Vec3(0.55f, 0.5f, 0.3f), 0.3f), nullptr, nullptr);
+  if (fourth) scene.add_sphere(sphere(Vec3(0.5f, -0.6f, 0.55f), 0.25f), nullptr, nullptr);
   for (int i = 0; i < extra; ++i)
     scene.add_sphere(sphere(Vec3(1000.f + 3.f * i, 0.f, 0.f), 1e-3f), nullptr, nullptr);
   scene.commit();
@@ -57,9 +59,9 @@ void build(EmbreeScene& scene, int extra) {
 
 struct Scenes {
   EmbreeScene outside, inside;  // spheres tested outside Embree / all in Embree
-  Scenes() {
-    build(outside, 0);
-    build(inside, 3);
+  explicit Scenes(bool fourth = false) {
+    build(outside, 0, fourth);
+    build(inside, 3, fourth);
   }
 };
 
@@ -104,23 +106,29 @@ TEST(SpheresOutsideEmbree, OnlyAFewTopLevelSpheresQualify) {
 }
 
 TEST(SpheresOutsideEmbree, NearestHitsAndOcclusionAsEmbreeUserGeometry) {
-  Scenes s;
-  std::vector<Ray> rs = rays(s.inside, 30000);
-  int on_sphere = 0, occluded = 0, finite = 0;
-  for (size_t i = 0; i < rs.size(); ++i) {
-    auto a = s.outside.intersect(rs[i]), b = s.inside.intersect(rs[i]);
-    expect_same(a, b, static_cast<int>(i));
-    if (b && b->shape_id >= 2) ++on_sphere;  // ids: box, partition, spheres
-    bool occ = s.inside.occluded(rs[i]);
-    EXPECT_EQ(s.outside.occluded(rs[i]), occ) << "ray " << i;
-    occluded += occ;
-    finite += std::isfinite(rs[i].tmax);
+  for (bool fourth : {false, true}) {
+    SCOPED_TRACE(fourth ? "four spheres" : "three spheres");
+    Scenes s(fourth);
+    EXPECT_EQ(s.outside.spheres_outside_embree(), fourth ? 4u : 3u);
+    std::vector<Ray> rs = rays(s.inside, 30000);
+    int on_sphere = 0, on_fourth = 0, occluded = 0, finite = 0;
+    for (size_t i = 0; i < rs.size(); ++i) {
+      auto a = s.outside.intersect(rs[i]), b = s.inside.intersect(rs[i]);
+      expect_same(a, b, static_cast<int>(i));
+      if (b && b->shape_id >= 2) ++on_sphere;  // ids: box, partition, spheres
+      if (b && b->shape_id == 5) ++on_fourth;
+      bool occ = s.inside.occluded(rs[i]);
+      EXPECT_EQ(s.outside.occluded(rs[i]), occ) << "ray " << i;
+      occluded += occ;
+      finite += std::isfinite(rs[i].tmax);
+    }
+    // Every kind of ray and answer was exercised.
+    EXPECT_GT(on_sphere, 3000);
+    EXPECT_GT(finite, 5000);
+    EXPECT_GT(occluded, 2000);
+    EXPECT_LT(occluded, static_cast<int>(rs.size()) - 2000);
+    if (fourth) EXPECT_GT(on_fourth, 300);
   }
-  // Every kind of ray and answer was exercised.
-  EXPECT_GT(on_sphere, 3000);
-  EXPECT_GT(finite, 5000);
-  EXPECT_GT(occluded, 2000);
-  EXPECT_LT(occluded, static_cast<int>(rs.size()) - 2000);
 }
 
 TEST(SpheresOutsideEmbree, PacketsAsEmbreeUserGeometry) {

@@ -6,6 +6,8 @@
 
 #include <fmt/core.h>
 
+#include <bit>
+
 namespace penumbra {
 
 static void embree_error(void*, RTCError code, const char* message) {
@@ -235,16 +237,41 @@ void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const
 void EmbreeScene::commit() {
   if (has_curves_ || direct_spheres_.size() > kMaxDirectSpheres) direct_spheres_.clear();
   for (const DirectSphere& d : direct_spheres_) rtcDisableGeometry(rtcGetGeometry(scene_, d.id));
+  direct_lanes_ = DirectSphereLanes{};
+  for (size_t k = 0; k < direct_spheres_.size(); ++k) {
+    const Sphere& sphere = *direct_spheres_[k].sphere;
+    direct_lanes_.cx[k] = sphere.center().x, direct_lanes_.cy[k] = sphere.center().y;
+    direct_lanes_.cz[k] = sphere.center().z, direct_lanes_.r2[k] = sphere.radius() * sphere.radius();
+    direct_lanes_.used |= 1u << k;
+  }
   rtcCommitScene(scene_);
+}
+
+// The pre-test of every direct sphere in one pass: lanes past the spheres' count are masked off.
+// Sphere by sphere, the two spheres of the benchmark scenes cost 45-55 more instructions per ray.
+unsigned EmbreeScene::direct_sphere_candidates(const Ray& ray) const {
+  const DirectSphereLanes& l = direct_lanes_;
+  auto lanes = [](float x) { return Lanes{} + x; };
+  auto missed = sphere_surely_missed<Lanes>(lanes(ray.o.x), lanes(ray.o.y), lanes(ray.o.z), lanes(ray.d.x),
+                                            lanes(ray.d.y), lanes(ray.d.z), l.cx, l.cy, l.cz, l.r2);
+#if defined(__SSE__)
+  unsigned missed_bits = unsigned(__builtin_ia32_movmskps(reinterpret_cast<Lanes>(missed)));  // lane k: bit k
+#else
+  unsigned missed_bits = 0;
+  for (unsigned k = 0; k < kMaxDirectSpheres; ++k) missed_bits |= unsigned(missed[k] != 0) << k;
+#endif
+  return ~missed_bits & l.used;
 }
 
 unsigned EmbreeScene::nearest_direct_sphere(const Ray& ray, float* t_max) const {
   unsigned id = RTC_INVALID_GEOMETRY_ID;
-  for (const DirectSphere& d : direct_spheres_)
-    if (auto t = d.sphere->intersect(ray, 0.f, *t_max)) {
+  for (unsigned c = direct_sphere_candidates(ray); c != 0; c &= c - 1) {
+    const DirectSphere& d = direct_spheres_[std::countr_zero(c)];
+    if (auto t = d.sphere->solve(ray, 0.f, *t_max)) {
       *t_max = *t;
       id = d.id;
     }
+  }
   return id;
 }
 
@@ -557,8 +584,9 @@ Rgb EmbreeScene::transmittance(int medium, float distance, const SampledWaveleng
 
 bool EmbreeScene::occluded(const Ray& ray) const {
   count_ray();
-  for (const DirectSphere& d : direct_spheres_)  // any hit will do, so no nearest_direct_sphere()
-    if (d.sphere->intersect(ray, 0.f, ray.tmax)) return true;
+  if (!direct_spheres_.empty())  // any hit will do, so no nearest_direct_sphere()
+    for (unsigned c = direct_sphere_candidates(ray); c != 0; c &= c - 1)
+      if (direct_spheres_[std::countr_zero(c)].sphere->solve(ray, 0.f, ray.tmax)) return true;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   float t_scale, t_shift;

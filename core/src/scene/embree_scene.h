@@ -176,6 +176,15 @@ class EmbreeScene final : public Scene {
   };
   static constexpr size_t kMaxDirectSpheres = 4;
   std::vector<DirectSphere> direct_spheres_;
+  // Their centres and squared radii in lanes, for the pre-test of all at once.
+  using Lanes = float __attribute__((vector_size(4 * kMaxDirectSpheres)));
+  struct DirectSphereLanes {
+    Lanes cx, cy, cz, r2;
+    unsigned used;  // bit k: lane k holds a sphere
+  };
+  DirectSphereLanes direct_lanes_{};
+  /// Bit k set: direct sphere k may be hit by `ray` (sphere_surely_missed() of each, in one pass).
+  unsigned direct_sphere_candidates(const Ray& ray) const;
   std::vector<std::unique_ptr<Quadric>> quadrics_;
   std::vector<std::unique_ptr<Curves>> curves_;
   bool has_curves_ = false;  // rays then reach Embree moved back by curve_back_ (see embree_ray())

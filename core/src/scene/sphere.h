@@ -9,6 +9,25 @@
 
 namespace penumbra {
 
+/// Float arithmetic that says "missed" only when the ray o + t d surely misses the sphere of centre c
+/// and squared radius r2: its line passes the centre farther than the radius by a margin far above
+/// float rounding, or the origin is clearly outside and the ray points away. Scenes that test their
+/// few spheres for every ray (EmbreeScene, "spheres outside Embree") spent 8 % of bdpt's time in the
+/// out-of-line solve() without it. Without branches and generic in F: for float it answers a bool,
+/// for a GCC vector of floats (EmbreeScene's four spheres at once) a lane mask.
+template <class F>
+inline auto sphere_surely_missed(F ox, F oy, F oz, F dx, F dy, F dz, F cx, F cy, F cz, F r2) {
+  F ocx = ox - cx, ocy = oy - cy, ocz = oz - cz;
+  F oc2 = ocx * ocx + ocy * ocy + ocz * ocz;
+  F oc_d = ocx * dx + ocy * dy + ocz * dz;
+  // |oc x d|^2 = a * (squared distance of the line from the centre); its float error is a few ulps of
+  // a * |oc|^2, so a margin of 1e-4 of that is safe.
+  F wx = ocy * dz - dy * ocz, wy = ocz * dx - dz * ocx, wz = ocx * dy - dx * ocy;
+  F w2 = wx * wx + wy * wy + wz * wz;
+  F a = dx * dx + dy * dy + dz * dz;
+  return ((oc2 > r2 * 1.01f) & (oc_d >= 0.f)) | (w2 > a * (r2 + 1e-4f * oc2));
+}
+
 class Sphere final : public Shape {
  public:
   /// `object_to_world` must be a similarity transform; `inward` flips the normal inside.
@@ -40,20 +59,9 @@ class Sphere final : public Shape {
                         const Vec3& n_hit) const override;
 
  private:
-  // Float arithmetic that says "missed" only when the ray surely misses: the line passes the centre
-  // farther than the radius by a margin far above float rounding, or the origin is clearly outside
-  // and the ray points away. A scene that tests its few spheres for every ray (EmbreeScene, "spheres
-  // outside Embree") spent 8 % of bdpt's time in the out-of-line solve() otherwise, much of it
-  // returning the optional through memory. Inline, so a miss costs no call.
   bool surely_missed(const Ray& ray) const {
-    Vec3 oc = ray.o - center_;
-    float r2 = radius_ * radius_, oc2 = glm::dot(oc, oc);
-    if (oc2 > r2 * 1.01f && glm::dot(oc, ray.d) >= 0.f) return true;  // outside, moving away
-    // |oc x d|^2 = a * (squared distance of the line from the centre); its float error is a few
-    // ulps of a * |oc|^2, so a margin of 1e-4 of that is safe.
-    Vec3 w = glm::cross(oc, ray.d);
-    float a = glm::dot(ray.d, ray.d);
-    return glm::dot(w, w) > a * (r2 + 1e-4f * oc2);
+    return sphere_surely_missed<float>(ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z, center_.x,
+                                       center_.y, center_.z, radius_ * radius_);
   }
   Vec3 center_;
   float radius_;
