@@ -98,7 +98,7 @@ std::vector<float> read_channels(OIIO::ImageInput& in, const std::string& path, 
                          : rows_wanted;
   std::vector<float> pixels;
   pixels.reserve(row * size_t(spec.height));
-  std::unique_ptr<float[]> decoded(new float[row * size_t(std::min(band, spec.height))]);
+  auto decoded = std::make_unique_for_overwrite<float[]>(row * size_t(std::min(band, spec.height)));
   for (int y = 0; y < spec.height; y += band) {
     int rows = std::min(band, spec.height - y);
     int ybegin = spec.y + y, yend = ybegin + rows;

@@ -44,8 +44,9 @@ struct ImageCodecs {
   void (*write)(const std::string& path, const std::string& temporary, const RasterToWrite& raster);
   /// Reads channels [0, min(file channels, max_channels)). Throws Error naming `path` when the file
   /// cannot be decoded, or when its header claims more decoded values (pixels x channels read) than a
-  /// 16384 x 8192 RGB image, more than 2 GiB of uncompressed pixel data in the file, more than
-  /// kMaxImageChannels channels or a volume (a damaged or hostile header must not make anyone allocate).
+  /// 16384 x 8192 RGB image, more than 2 GiB of uncompressed pixel data in the file (or more than
+  /// 256 MiB in a file under 1/4096 of it), more than kMaxImageChannels channels or a volume (a
+  /// damaged or hostile header must not make anyone allocate).
   RasterRead (*read)(const std::string& path, int max_channels);
 };
 
