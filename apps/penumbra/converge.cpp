@@ -40,6 +40,8 @@ struct Row {
   ImageErrors errors;
 };
 
+bool making_reference(const ConvergeSettings& s) { return s.make_reference > 0.0 || s.make_reference_spp > 0; }
+
 RenderSettings base_settings(const ConvergeSettings& s, const ConvergeConfig& config, uint32_t seed) {
   RenderSettings r;
   r.scene_file = s.scene;
@@ -81,8 +83,10 @@ fs::path reference_cache_dir() {
 void make_reference(const ConvergeSettings& s, const std::vector<std::string>& halves_configs, ImageRgb* reference,
                     ImageRgb* variance, std::string* description) {
   std::string res = s.resolution ? fmt::format("{}x{}", s.resolution->first, s.resolution->second) : "scene";
-  std::string key = fmt::format("{}-{}-{}-{}-{:g}s", scene_hash(parse_scene_file(s.scene)), res, halves_configs[0],
-                                halves_configs[1], s.make_reference);
+  std::string amount = s.make_reference_spp > 0 ? fmt::format("{}spp", s.make_reference_spp)
+                                                : fmt::format("{:g}s", s.make_reference);
+  std::string key = fmt::format("{}-{}-{}-{}-{}", scene_hash(parse_scene_file(s.scene)), res, halves_configs[0],
+                                halves_configs[1], amount);
   for (char& c : key)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
   *description = halves_configs[0] == halves_configs[1] ? halves_configs[0] : halves_configs[0] + " + " + halves_configs[1];
@@ -95,8 +99,13 @@ void make_reference(const ConvergeSettings& s, const std::vector<std::string>& h
     for (int h = 0; h < 2; ++h) {
       ConvergeConfig config = parse_configs(halves_configs[h], "--reference-config").at(0);
       RenderSettings r = base_settings(s, config, 1000001u + h);
-      r.time_budget = s.make_reference / 2.0;
-      std::fprintf(stderr, "converge: reference half %d (%s, %.0f s)\n", h + 1, halves_configs[h].c_str(), r.time_budget);
+      if (s.make_reference_spp > 0)
+        r.spp = s.make_reference_spp;
+      else
+        r.time_budget = s.make_reference / 2.0;
+      std::string budget = s.make_reference_spp > 0 ? fmt::format("{} spp", s.make_reference_spp)
+                                                     : fmt::format("{:.0f} s", r.time_budget);
+      std::fprintf(stderr, "converge: reference half %d (%s, %s)\n", h + 1, halves_configs[h].c_str(), budget.c_str());
       halves[h] = render(r).image;
     }
     std::error_code ec;
@@ -226,7 +235,7 @@ int run_converge(const ConvergeSettings& s) {
   for (const ConvergeConfig& c : s.configs) check_param_overrides(c.integrator, c.params);
   std::vector<std::string> reference_configs =
       s.reference_config.empty() ? default_reference_configs(s.configs) : std::vector<std::string>{s.reference_config, s.reference_config};
-  if (s.make_reference > 0.0)
+  if (making_reference(s))
     for (const std::string& rc : reference_configs) {
       ConvergeConfig ref = parse_configs(rc, "--reference-config").at(0);
       check_param_overrides(ref.integrator, ref.params);
@@ -241,7 +250,7 @@ int run_converge(const ConvergeSettings& s) {
   ImageRgb reference, variance;
   bool have_variance = false;
   std::string reference_description = s.reference.empty() ? "" : s.reference;
-  if (s.make_reference > 0.0) {
+  if (making_reference(s)) {
     make_reference(s, reference_configs, &reference, &variance, &reference_description);
     have_variance = true;
   } else if (!s.reference.empty()) {
@@ -252,7 +261,7 @@ int run_converge(const ConvergeSettings& s) {
       have_variance = true;
     }
   } else {
-    throw Error("give --reference REF.exr or --make-reference SECONDS");
+    throw Error("give --reference REF.exr, --make-reference SECONDS or --make-reference-spp N");
   }
 
   std::vector<double> times;

@@ -24,6 +24,7 @@ struct ConvergeSettings {
   std::string scene;
   std::string reference;                 // EXR of the reference (or empty with make_reference)
   double make_reference = 0.0;           // seconds for a new reference (two independent halves)
+  int make_reference_spp = 0;            // or samples per pixel of each half (0: by time)
   std::string reference_config;          // empty: an unbiased integrator not compared (path, else bdpt, else both)
   std::vector<ConvergeConfig> configs;
   double time = 60.0;                    // budget per run, seconds

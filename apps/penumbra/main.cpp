@@ -104,8 +104,12 @@ int main(int argc, char** argv) {
   converge->add_option("--configs", conv_configs, "comma-separated integrator[/NAME=VALUE...][:sampler] list, e.g. "
                        "path:sobol,bdpt/maxdepth=8:sobol; NAME=VALUE sets an integrator parameter as --param does")->required();
   converge->add_option("--reference", conv.reference, "reference image (EXR); reference-variance.exr beside it is used if present")->check(CLI::ExistingFile);
-  converge->add_option("--make-reference", conv.make_reference, "render a reference for this many seconds (two halves)")
-      ->check(penumbra::cli::positive_number("seconds"));
+  auto* make_ref = converge->add_option("--make-reference", conv.make_reference,
+                                        "render a reference for this many seconds (two halves)")
+                       ->check(penumbra::cli::positive_number("seconds"));
+  converge->add_option("--make-reference-spp", conv.make_reference_spp,
+                       "render a reference of two halves of this many samples per pixel each (instead of a time)")
+      ->check(penumbra::cli::positive_whole_number())->excludes(make_ref);
   converge->add_option("--reference-config", conv.reference_config, "integrator[/NAME=VALUE...][:sampler] for --make-reference (default: path, or bdpt when path is compared, or one half each)");
   converge->add_option("--time", conv.time, "time budget per run, seconds")->check(penumbra::cli::positive_number("seconds"));
   converge->add_option("--runs", conv.runs, "independent runs per configuration (medians, quartiles and bootstrap intervals over them)")
