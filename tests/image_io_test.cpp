@@ -353,7 +353,7 @@ TEST_F(ImageIo, ExrClaimingAWideImageIsRefusedOrFailsWithoutAllocatingIt) {
   EXPECT_NE(message.find("believed.exr': its header claims 1099 MiB of pixel data (8000000x12 pixels, 3 channels)"),
             std::string::npos)
       << message;
-  // Control: the same file, not widened, reads.
+  // Control: a valid EXR from the same writer reads (growth_refusing() wrote warm.exr).
   EXPECT_EQ(read_image(path("warm.exr")).width, gradient().width);
 }
 
