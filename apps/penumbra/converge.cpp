@@ -99,12 +99,14 @@ void make_reference(const ConvergeSettings& s, const std::vector<std::string>& h
     for (int h = 0; h < 2; ++h) {
       ConvergeConfig config = parse_configs(halves_configs[h], "--reference-config").at(0);
       RenderSettings r = base_settings(s, config, 1000001u + h);
-      if (s.make_reference_spp > 0)
+      std::string budget;
+      if (s.make_reference_spp > 0) {
         r.spp = s.make_reference_spp;
-      else
+        budget = fmt::format("{} spp", *r.spp);
+      } else {
         r.time_budget = s.make_reference / 2.0;
-      std::string budget = s.make_reference_spp > 0 ? fmt::format("{} spp", s.make_reference_spp)
-                                                     : fmt::format("{:.0f} s", r.time_budget);
+        budget = fmt::format("{:.0f} s", r.time_budget);
+      }
       std::fprintf(stderr, "converge: reference half %d (%s, %s)\n", h + 1, halves_configs[h].c_str(), budget.c_str());
       halves[h] = render(r).image;
     }
