@@ -44,8 +44,13 @@ PENUMBRA_X86_64_V3_CLONES Vec2 sample_uniform_disk_concentric(Vec2 u) { return d
 
 PENUMBRA_X86_64_V3_CLONES Vec3 sample_cosine_hemisphere(Vec2 u) {
   // Malley's method: uniform on the disk, projected up onto the hemisphere, is cosine-distributed.
+  // The disk point's radius is |r| of the concentric map, known before its angle: z = sqrt(1 - r^2)
+  // is computed alongside the angle's polynomial instead of after it (the direction feeds the next
+  // ray, so this chain's latency is paid per bounce).
+  Vec2 o = 2.f * u - Vec2(1.f);
+  float r = std::max(std::abs(o.x), std::abs(o.y));
   Vec2 d = disk_concentric(u);
-  return Vec3(d.x, d.y, safe_sqrt(1.f - d.x * d.x - d.y * d.y));
+  return Vec3(d.x, d.y, safe_sqrt(1.f - r * r));
 }
 
 Vec3 sample_uniform_sphere(Vec2 u) {

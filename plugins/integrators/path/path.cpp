@@ -92,14 +92,17 @@ class PathIntegrator final : public PixelIntegrator {
       // its delta samples are told apart below by their own flag (no MIS for what they hit).
       float u_light = sampler.get_1d();
       Vec2 u_light_point = sampler.get_2d();
-      if (light_sampling_ && flags != 0 && !Bsdf::is_specular_only(flags))
-        L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point, medium, wavelengths);
-
-      // Continue the path by sampling the BSDF.
+      // The BSDF sample that continues the path is drawn before next-event estimation and used after
+      // it: its chain of dependent arithmetic then overlaps the light sample and the shadow ray
+      // instead of delaying the next ray (same values, same sampler dimensions, in the same order).
       float u_lobe = sampler.get_1d();
       Vec2 u_dir = sampler.get_2d();
       float u_rr = sampler.get_1d();
       std::optional<BsdfSample> bs = flags ? bsdf.sample_f(wo, u_lobe, u_dir, sctx) : std::nullopt;
+      if (light_sampling_ && flags != 0 && !Bsdf::is_specular_only(flags))
+        L += beta * sample_direct(*si, wo, bsdf, sctx, scene, u_light, u_light_point, medium, wavelengths);
+
+      // Continue the path with the BSDF sample.
       if (!bs || !(bs->pdf > 0.f) || is_black(bs->f)) break;
       Vec3 wi = si->shading.to_world(bs->wi);
       // Reject directions that the shading normal calls reflection but the geometry calls
