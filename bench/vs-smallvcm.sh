@@ -124,24 +124,12 @@ print(d['samples_per_pixel'], d['seconds'])" "$work/$name.json")
   done
 done
 
-"$py" - "$csv" <<'EOF'
-import csv, math, statistics, sys
+"$py" - "$csv" "$root/bench" <<'EOF'
+import csv, statistics, sys
+sys.path.insert(0, sys.argv[2])
+from pair_stats import median_interval
 rows = list(csv.DictReader(open(sys.argv[1])))
 names = {"pt": "path", "bpt": "bdpt", "ppm": "sppm"}
-
-def median_interval(q, level=0.95):
-    """The narrowest symmetric pair of order statistics [q(j), q(n-1-j)] that covers the median with
-    probability >= level whatever the distribution: the count of values below the median is
-    Binomial(n, 1/2). None when n is too small for the level (n < 6 at 95 %)."""
-    q = sorted(q)
-    n = len(q)
-    best = None
-    for j in range(n // 2 + 1):
-        coverage = sum(math.comb(n, i) for i in range(j + 1, n - j)) / 2 ** n
-        if coverage < level:
-            break
-        best = (q[j], q[n - 1 - j])
-    return best
 
 print("| scene | algorithm | SmallVCM passes/s | Penumbra passes/s | ratio | pairs: median [95 % interval] (range) "
       "| SmallVCM relMSE | Penumbra relMSE | ratio | pairs: median [95 % interval] (range) |")
