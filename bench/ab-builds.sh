@@ -117,6 +117,7 @@ if equal_time and all(r["relmse"] for r in rows):
 for name, f in measures:
     base = statistics.median(f(p["base"]) for p in full)
     new = statistics.median(f(p["new"]) for p in full)
-    print(f"{name}: base {base:.4g}, new {new:.4g}; pairs new / base: {describe_ratios([f(p['new']) / f(p['base']) for p in full])}")
+    ratios = [f(p["new"]) / f(p["base"]) for p in full]
+    print(f"{name}: base {base:.4g}, new {new:.4g}; pairs new / base: {describe_ratios(ratios)}, {len(ratios)} pairs")
 EOF
 [ -z "$keep" ] || echo "ab-builds.sh: every render's figures are in $csv" >&2

@@ -24,9 +24,9 @@ def median_interval(q, level=0.95):
 
 
 def describe_ratios(q, digits=3):
-    """'median [95 % interval] (min-max), n pairs' of a list of ratios; '-' when empty."""
+    """'median [95 % interval] (min-max)' of a list of ratios; '-' when empty."""
     if not q:
         return "-"
     ci = median_interval(q)
     interval = f"[{ci[0]:.{digits}f}, {ci[1]:.{digits}f}]" if ci else "[-]"
-    return f"{statistics.median(q):.{digits}f} {interval} ({min(q):.{digits}f}-{max(q):.{digits}f}), {len(q)} pairs"
+    return f"{statistics.median(q):.{digits}f} {interval} ({min(q):.{digits}f}-{max(q):.{digits}f})"

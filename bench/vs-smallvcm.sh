@@ -127,7 +127,7 @@ done
 "$py" - "$csv" "$root/bench" <<'EOF'
 import csv, statistics, sys
 sys.path.insert(0, sys.argv[2])
-from pair_stats import median_interval
+from pair_stats import describe_ratios
 rows = list(csv.DictReader(open(sys.argv[1])))
 names = {"pt": "path", "bpt": "bdpt", "ppm": "sppm"}
 
@@ -152,11 +152,7 @@ for scene, alg in cells:
     # on a rerun.
     def pairs(f):
         q = [f(p["penumbra"]) / f(p["smallvcm"]) for p in runs.values() if "penumbra" in p and "smallvcm" in p]
-        if not q:
-            return "-"
-        ci = median_interval(q)
-        interval = f"[{ci[0]:.2f}, {ci[1]:.2f}]" if ci else "[-]"
-        return f"{statistics.median(q):.2f} {interval} ({min(q):.2f}-{max(q):.2f})"
+        return describe_ratios(q, digits=2)
     sv, pn = med("smallvcm", rate), med("penumbra", rate)
     svr, pnr = med("smallvcm", rel), med("penumbra", rel)
     print(f"| {scene} | {alg} / {names[alg]} | {sv:.2f} | {pn:.2f} | {pn / sv:.2f} | {pairs(rate)} "
