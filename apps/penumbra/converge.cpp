@@ -120,16 +120,6 @@ void make_reference(const ConvergeSettings& s, const std::vector<std::string>& h
   write_image((fs::path(s.out_dir) / "reference-variance.exr").string(), *variance);
 }
 
-// The reference's own error in relMSE units: mean over pixels and channels of Var(R) / (R^2 + eps).
-double reference_relmse(const ImageRgb& reference, const ImageRgb& variance) {
-  double sum = 0.0;
-  for (size_t i = 0; i < reference.pixels.size(); ++i) {
-    double r = reference.pixels[i];
-    sum += variance.pixels[i] / (r * r + kRelMseEpsilon);
-  }
-  return reference.pixels.empty() ? 0.0 : sum / reference.pixels.size();
-}
-
 // Time at which a mean error curve first reaches `target`, interpolated in log-log; -1 if never.
 double time_to_reach(const std::vector<std::pair<double, double>>& curve, double target) {
   for (size_t i = 0; i < curve.size(); ++i) {
@@ -372,14 +362,17 @@ int run_converge(const ConvergeSettings& s) {
   // ranking may be the reference's, and the report says so loudly.
   summary["reference"]["made_by"] = reference_description;
   if (have_variance) {
-    double ref_error = reference_relmse(reference, variance), smallest = 1e300;
+    const ReferenceNoise noise = reference_noise(reference, variance);
+    double ref_error = noise.error, smallest = 1e300;
     for (const auto& [name, curve] : curves)
       if (!curve.empty()) smallest = std::min(smallest, curve.back().second);
     bool trusted = smallest > 0.0 && ref_error <= 0.1 * smallest;
     summary["reference"]["relmse"] = ref_error;
+    summary["reference"]["floor"] = noise.floor;
     summary["reference"]["smallest_compared_relmse"] = smallest;
     summary["reference"]["trusted"] = trusted;
-    std::fprintf(stderr, "converge: reference (%s) own relMSE %.3g, %.0f %% of the smallest error compared (%.3g)%s\n",
+    std::fprintf(stderr, "converge: reference (%s) own relMSE %.3g (over its neighbours' mean), %.0f %% of the "
+                 "smallest error compared (%.3g)%s\n",
                  reference_description.c_str(), ref_error, smallest > 0 ? 100.0 * ref_error / smallest : 0.0, smallest,
                  trusted ? "" : ": WARNING: above 10 %, the reference's own noise may decide the ranking; make a longer reference");
   }

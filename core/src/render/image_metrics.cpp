@@ -65,4 +65,32 @@ ImageRgb half_reference_variance(const ImageRgb& a, const ImageRgb& b, ImageRgb*
   return var;
 }
 
+ReferenceNoise reference_noise(const ImageRgb& reference, const ImageRgb& variance) {
+  check_same_size(reference, variance);
+  ReferenceNoise n;
+  const int w = reference.width, h = reference.height;
+  if (reference.pixels.empty()) return n;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const size_t i = 3 * (static_cast<size_t>(y) * w + x) + c;
+        double r = reference.pixels[i], v = std::max(0.0, static_cast<double>(variance.pixels[i]));
+        double sum = 0;
+        int count = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            int nx = x + dx, ny = y + dy;
+            if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+            sum += reference.pixels[3 * (static_cast<size_t>(ny) * w + nx) + c];
+            ++count;
+          }
+        double m = count ? sum / count : r;  // a 1x1 image has no neighbours
+        n.floor += v / (r * r + kRelMseEpsilon);
+        n.error += v / (m * m + kRelMseEpsilon);
+      }
+  n.floor /= static_cast<double>(reference.pixels.size());
+  n.error /= static_cast<double>(reference.pixels.size());
+  return n;
+}
+
 }  // namespace penumbra

@@ -27,4 +27,20 @@ ImageErrors image_errors(const ImageRgb& image, const ImageRgb& reference,
 /// estimated per pixel by (A - B)^2 / 4. Also returns their mean in `mean`.
 ImageRgb half_reference_variance(const ImageRgb& a, const ImageRgb& b, ImageRgb* mean);
 
+/// A two-halves reference's noise in relMSE units, from its mean R and per-pixel variance V
+/// (half_reference_variance()), averaged over pixels and channels:
+struct ReferenceNoise {
+  /// mean V / (R^2 + eps): what a perfect image would still show against R, and what image_errors()
+  /// subtracts. Its denominator holds the noise it measures, so a firefly in one half counts about 1
+  /// in its pixel however far it is from the truth: it is no estimate of R's own error.
+  double floor = 0;
+  /// R's own error, E[(R - mu)^2] / (mu^2 + eps), estimated by V / (m^2 + eps) with m the mean of R
+  /// over the pixel's (up to 8) neighbours: samples independent of the pixel's own, so a firefly is
+  /// weighed against its surroundings as the truth would weigh it. On 12 reference pairs it was 0.91-1.24x
+  /// of the error measured against long references, where `floor` was 0.04-1.9x (docs/algorithms.md,
+  /// "A reference's own error").
+  double error = 0;
+};
+ReferenceNoise reference_noise(const ImageRgb& reference, const ImageRgb& variance);
+
 }  // namespace penumbra
