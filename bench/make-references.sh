@@ -7,7 +7,8 @@
 # never used by the benchmark's runs), combined weighted by their sample counts (w1, w2). Their
 # difference estimates the reference's own variance, about w1 w2 (A - B)^2 per pixel; relmse_floor,
 # its mean over (R^2 + 0.01), is the relMSE a perfect image would still show against this reference
-# (every relMSE the benchmark measures includes it).
+# (every relMSE the benchmark measures includes it), and relmse_own_error, over the square of each
+# pixel's neighbours' mean instead, estimates the reference's own relMSE against the truth.
 # The integrator is the scene's entry in bench/scenes.sh: path tracing, or bdpt where path tracing
 # misses light (the point light's caustic through the glass sphere).
 #
@@ -64,11 +65,10 @@ for s in $scene_list; do
   w2=$("$py" -c "print($spp2 / ($spp1 + $spp2))")
   oiiotool "$work/$s-1.exr" --mulc "$w1" "$work/$s-2.exr" --mulc "$w2" --add -o "$work/$s-ref.exr"
   oiiotool "$work/$s-ref.exr" -d half --compression piz -o "$out/$s.exr"
-  # The reference's variance per pixel is about w1 w2 (A - B)^2; relMSE of R + sqrt(w1 w2) (A - B)
-  # against R is the mean of that variance over (R^2 + 0.01): the reference's own share of any relMSE.
-  c=$("$py" -c "print(($w1 * $w2) ** 0.5)")
-  oiiotool "$work/$s-1.exr" "$work/$s-2.exr" --sub --mulc "$c" "$work/$s-ref.exr" --add -o "$work/$s-plus.exr"
-  errors=$("$build/bin/penumbra-bench-image-errors" "$work/$s-plus.exr" "$work/$s-ref.exr")
+  # The reference's variance per pixel is about w1 w2 (A - B)^2. Over (R^2 + 0.01) its mean is the
+  # floor, the reference's own share of any relMSE measured against it; over the square of each
+  # pixel's neighbours' mean it estimates the reference's own error (docs/algorithms.md).
+  errors=$("$build/bin/penumbra-bench-image-errors" --reference-noise "$work/$s-1.exr" "$spp1" "$work/$s-2.exr" "$spp2")
   "$py" - "$out/$s.json" "$s" "$(bench_scene_file "$s")" "$integrator" "$time_budget" "$threads" \
       "$commit" "$(nproc)" "$(bench_cpu_model)" "$(bench_loadavg)" "$errors" "$work/$s-1.json" "$work/$s-2.json" \
       "$out/$s.exr" <<'EOF'
@@ -82,9 +82,13 @@ meta = {
     "spp": sum(x["spp"] for x in st), "threads": int(threads), "seeds": [x["seed"] for x in st],
     "nonfinite_samples": sum(x["nonfinite_samples"] for x in st),
     "resolution": [e["width"], e["height"]],
-    "relmse_floor": e["relmse"],
+    "relmse_floor": e["floor"],
     "relmse_floor_note": "mean over pixels and channels of w1 w2 (A - B)^2 / (R^2 + 0.01): the reference's "
                          "own noise in relMSE units, included in every relMSE measured against it",
+    "relmse_own_error": e["own_error"],
+    "relmse_own_error_note": "mean over pixels and channels of w1 w2 (A - B)^2 / (m^2 + 0.01), m the mean of "
+                             "R over the pixel's neighbours: the reference's own relMSE against the truth "
+                             "(docs/algorithms.md, \"A reference's own error\")",
     "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds"),
     "commit": commit, "nproc": int(nproc), "cpu": cpu, "loadavg_at_start": load,
     "file_bytes": os.path.getsize(exr), "format": "half-float RGB EXR, PIZ",
@@ -92,6 +96,7 @@ meta = {
 json.dump(meta, open(path, "w"), indent=2)
 open(path, "a").write("\n")
 print(f"make-references: {scene}: {meta['spp']} spp in {meta['render_seconds']:.0f} s ({integrator}), "
-      f"relMSE floor {meta['relmse_floor']:.3g}, {meta['file_bytes'] / 1e6:.2f} MB -> {exr}", file=sys.stderr)
+      f"relMSE floor {meta['relmse_floor']:.3g}, own error {meta['relmse_own_error']:.3g}, "
+      f"{meta['file_bytes'] / 1e6:.2f} MB -> {exr}", file=sys.stderr)
 EOF
 done

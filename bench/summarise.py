@@ -66,7 +66,9 @@ def main():
         elif ref_meta is not None:
             notes.append(f"{scene}: reference {ref_meta['integrator']}, {ref_meta['spp']} spp in "
                          f"{ref_meta['render_seconds']:.0f} s ({ref_meta['date'][:10]}, {ref_meta['commit']}); "
-                         f"its own noise floor relMSE ~ {fmt(ref_meta.get('relmse_floor'), '.2g')}")
+                         f"its own noise floor relMSE ~ {fmt(ref_meta.get('relmse_floor'), '.2g')}"
+                         + (f", its own error ~ {fmt(ref_meta['relmse_own_error'], '.2g')}"
+                            if "relmse_own_error" in ref_meta else ""))
         for integ in a.integrators.split(","):
             stats, errs = [], []
             for k in range(1, a.runs + 1):

@@ -53,6 +53,17 @@ TEST(ImageMetrics, HalfReferenceVarianceIsSubtracted) {
   EXPECT_NEAR(raw.mse - corrected.mse, 0.01, 1e-6);
 }
 
+// Halves of unequal sample counts: R = w A + (1 - w) B with w = n_A / (n_A + n_B), and Var(R) =
+// w (1 - w) E[(A - B)^2] (for per-sample variance s^2: w^2 s^2 / n_A + (1 - w)^2 s^2 / n_B = s^2 / n).
+TEST(ImageMetrics, UnequalHalvesAreWeightedBySampleCounts) {
+  ImageRgb a = constant_image(2, 2, 1.0f), b = constant_image(2, 2, 1.3f), mean;
+  ImageRgb var = half_reference_variance(a, b, &mean, 1.0 / 3.0);  // 1 sample against 2
+  EXPECT_NEAR(mean.pixels[0], 1.2f, 1e-6f);
+  EXPECT_NEAR(var.pixels[0], 0.02f, 1e-7f);
+  EXPECT_THROW(half_reference_variance(a, b, &mean, 0.0), Error);
+  EXPECT_THROW(half_reference_variance(a, b, &mean, 1.0), Error);
+}
+
 // A reference's own error from its two halves, on synthetic pixels whose true mean mu is known: each
 // half is the mean of n samples, the reference their mean R, and the error it should estimate is the
 // mean over pixels of (R - mu)^2 / (mu^2 + 0.01). 3 x 40,000 values per case, fixed seed.

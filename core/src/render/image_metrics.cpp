@@ -53,14 +53,15 @@ ImageErrors image_errors(const ImageRgb& image, const ImageRgb& reference, const
   return e;
 }
 
-ImageRgb half_reference_variance(const ImageRgb& a, const ImageRgb& b, ImageRgb* mean) {
+ImageRgb half_reference_variance(const ImageRgb& a, const ImageRgb& b, ImageRgb* mean, double w_a) {
   check_same_size(a, b);
+  if (!(w_a > 0.0 && w_a < 1.0)) throw Error(fmt::format("half-reference weight {} is not in (0, 1)", w_a));
   ImageRgb var = a;
   if (mean) *mean = a;
   for (size_t i = 0; i < a.pixels.size(); ++i) {
     double d = a.pixels[i] - b.pixels[i];
-    var.pixels[i] = static_cast<float>(d * d / 4.0);
-    if (mean) mean->pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
+    var.pixels[i] = static_cast<float>(w_a * (1.0 - w_a) * d * d);
+    if (mean) mean->pixels[i] = static_cast<float>(w_a * a.pixels[i] + (1.0 - w_a) * b.pixels[i]);
   }
   return var;
 }

@@ -24,8 +24,10 @@ ImageErrors image_errors(const ImageRgb& image, const ImageRgb& reference,
                          const ImageRgb* reference_variance = nullptr);
 
 /// Per-pixel variance of the mean of two independent half-references: Var((A + B) / 2) = E[(A - B)^2] / 4,
-/// estimated per pixel by (A - B)^2 / 4. Also returns their mean in `mean`.
-ImageRgb half_reference_variance(const ImageRgb& a, const ImageRgb& b, ImageRgb* mean);
+/// estimated per pixel by (A - B)^2 / 4. Also returns their mean in `mean`. Halves of unequal sample
+/// counts n_a, n_b are combined with w_a = n_a / (n_a + n_b): R = w_a A + (1 - w_a) B, whose variance
+/// w_a (1 - w_a) E[(A - B)^2] is estimated by w_a (1 - w_a) (A - B)^2.
+ImageRgb half_reference_variance(const ImageRgb& a, const ImageRgb& b, ImageRgb* mean, double w_a = 0.5);
 
 /// A two-halves reference's noise in relMSE units, from its mean R and per-pixel variance V
 /// (half_reference_variance()), averaged over pixels and channels:
