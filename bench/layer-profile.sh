@@ -19,7 +19,7 @@
 #   --top     functions listed per renderer outside Embree (default 10)
 #   --keep    keep perf.data and the decoded stacks in DIR (default: a temporary folder)
 # Needs linux-perf (Debian: apt-get install linux-perf) and permission to profile
-# (kernel.perf_event_paranoid <= 2). About a minute; the recording is 80-100 MB.
+# (kernel.perf_event_paranoid <= 2). Under a minute; the recording is about 90 MB.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
