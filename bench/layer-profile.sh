@@ -72,8 +72,7 @@ owners = [("Li<0u>", "minimal"), ("render_with<0u>", "minimal"),
           ("PathIntegrator::Li", "path integrator: Li"),
           ("SampleIntegrator::render", "path integrator: render loop"),
           ("raw_embree", "raw Embree")]
-order = [name for _, name in owners]
-order = list(dict.fromkeys(order))
+order = list(dict.fromkeys(name for _, name in owners))  # each renderer once, in the table's order
 total = collections.Counter()
 embree = collections.Counter()
 leaves = collections.defaultdict(collections.Counter)
