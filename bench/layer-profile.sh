@@ -12,23 +12,36 @@
 # renders the same pixel samples, so the counts compare directly. perf here samples the cpu-clock
 # (this project's virtual machine has no hardware counters), about once per millisecond.
 #
-# Usage: bench/layer-profile.sh [--scene FILE] [--spp N] [--res N] [--top N] [--keep DIR] [--build DIR]
+# With --instructions it counts instead of sampling: valgrind's callgrind runs the same round and
+# dumps its counts after each renderer's render, so each renderer's instructions per pixel sample,
+# inside Embree (rtcIntersect1, rtcOccluded1, rtcIntersect8 and what they call) and elsewhere, come
+# out exactly and the same in every run: what a change to one layer does shows without the machine's
+# noise (but not its cache misses or stalls, which only the times above see).
+#
+# Usage: bench/layer-profile.sh [--scene FILE] [--spp N] [--res N] [--top N] [--instructions]
+#                               [--keep DIR] [--build DIR]
 #   --scene   default: the bundled Cornell box (bench/scenes/cornell-water-diffuse.pbrt also works;
 #             the minimal tracer takes only Lambertian triangles under area lights)
-#   --spp     samples per pixel of each render (default 16); --res film size (default 256)
-#   --top     functions listed per renderer outside Embree (default 10)
-#   --keep    keep perf.data and the decoded stacks in DIR (default: a temporary folder)
+#   --spp     samples per pixel of each render (default 16, or 8 with --instructions); --res film
+#             size (default 256, or 128 with --instructions). Much smaller renders trip the bench
+#             program's check that the two tracers' image means agree within 1 %.
+#   --top     functions listed per renderer outside Embree (default 10; not with --instructions)
+#   --instructions  count instructions with callgrind instead of sampling with perf
+#   --keep    keep perf.data and the decoded stacks (or the callgrind parts) in DIR (default: a
+#             temporary folder)
 # Needs linux-perf (Debian: apt-get install linux-perf) and permission to profile
-# (kernel.perf_event_paranoid <= 2). Under a minute; the recording is about 90 MB.
+# (kernel.perf_event_paranoid <= 2); under a minute, a recording of about 90 MB. --instructions needs
+# valgrind instead (apt-get install valgrind) and takes about a minute at its defaults.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 source "$root/bench/common.sh"
 
 scene=""
-spp=16
-res=256
+spp=""
+res=""
 top=10
+instructions=0
 keep=""
 build="$root/build"
 while [ $# -gt 0 ]; do
@@ -37,23 +50,78 @@ while [ $# -gt 0 ]; do
     --spp) spp="$2"; shift 2 ;;
     --res) res="$2"; shift 2 ;;
     --top) top="$2"; shift 2 ;;
+    --instructions) instructions=1; shift ;;
     --keep) keep="$2"; shift 2 ;;
     --build) build="$2"; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "layer-profile.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
+[ -n "$spp" ] || spp=$([ "$instructions" = 1 ] && echo 8 || echo 16)
+[ -n "$res" ] || res=$([ "$instructions" = 1 ] && echo 128 || echo 256)
 for n in spp res top; do
   [[ "${!n}" =~ ^[1-9][0-9]*$ ]] || { echo "layer-profile.sh: --$n must be a positive whole number, not '${!n}'" >&2; exit 2; }
 done
 [ -z "$scene" ] || [ -f "$scene" ] || { echo "layer-profile.sh: --scene: no file '$scene'" >&2; exit 2; }
-command -v perf > /dev/null || { echo "layer-profile.sh: needs perf (Debian: apt-get install linux-perf)" >&2; exit 1; }
+if [ "$instructions" = 1 ]; then
+  command -v valgrind > /dev/null || { echo "layer-profile.sh: needs valgrind (apt-get install valgrind)" >&2; exit 1; }
+else
+  command -v perf > /dev/null || { echo "layer-profile.sh: needs perf (Debian: apt-get install linux-perf)" >&2; exit 1; }
+fi
 bench_find_build "$build"
 py=$(bench_python)
 bench_work_dir "$keep" penumbra-layers
 
 args=(--threads 1 --rounds 1 --minimal --spp "$spp" --res "$res")
 [ -z "$scene" ] || args+=(--scene "$scene")
+
+if [ "$instructions" = 1 ]; then
+  # Dumps around the path integrator's render and after each layer's: each layer's part holds what
+  # ran since the dump before, its render and little else (the previous image's mean: 8 instructions
+  # per sample at the defaults).
+  echo "layer-profile.sh: callgrind of penumbra-bench-render ${args[*]} (commit $(bench_commit "$root"))" >&2
+  valgrind --tool=callgrind --callgrind-out-file="$work/parts.out" \
+    --dump-before='penumbra::SampleIntegrator::render(penumbra::RenderContext&)' \
+    --dump-after='penumbra::SampleIntegrator::render(penumbra::RenderContext&)' \
+    --dump-after='penumbra::MinimalRenderResult penumbra::MinimalPathTracer::render_with<*' \
+    "$build/bin/penumbra-bench-render" "${args[@]}" --rays 1000 > "$work/bench.txt" 2> "$work/valgrind.log" ||
+    { tail -20 "$work/valgrind.log" >&2; echo "layer-profile.sh: the counted run failed" >&2; exit 1; }
+  for part in "$work"/parts.out.*; do
+    callgrind_annotate --inclusive=yes "$part" > "$part.txt" 2> /dev/null
+  done
+  "$py" - "$work" "$((res * res * spp))" <<'EOF'
+import glob, re, sys
+
+# Each part's renderer, from the function whose end triggered its dump.
+work, samples = sys.argv[1], int(sys.argv[2])
+names = {"SampleIntegrator::render": "path integrator", "render_with<0u>": "minimal",
+         "render_with<1u>": "+ hit records", "render_with<3u>": "+ light sampling",
+         "render_with<7u>": "+ BSDF objects"}
+rows = {}
+for part in glob.glob(f"{work}/parts.out.*[0-9]"):
+    text = open(part).read()
+    trigger = re.search(r"^desc: Trigger: (.*)$", text, re.M).group(1)
+    if trigger.startswith("--dump-before"):
+        continue  # what ran before the path integrator's render: parsing, loading, building
+    name = next((n for key, n in names.items() if key in trigger), None)
+    if name is None:
+        continue
+    total = int(re.search(r"^totals: (\d+)", text, re.M).group(1))
+    embree = 0  # Embree's three entry points, inclusive (nothing else calls into Embree in a render)
+    for line in open(part + ".txt"):
+        m = re.match(r"\s*([\d,]+) .*\?\?\?:rtc(Intersect1|Occluded1|Intersect8) ", line)
+        if m:
+            embree += int(m.group(1).replace(",", ""))
+    rows[name] = (total, embree)
+print(f"instructions per pixel sample ({samples:,} samples per renderer)")
+print(f"{'renderer':20s} {'total':>8s} {'in Embree':>10s} {'elsewhere':>10s}")
+for name in ["minimal", "+ hit records", "+ light sampling", "+ BSDF objects", "path integrator"]:
+    if name in rows:
+        total, embree = rows[name]
+        print(f"{name:20s} {total / samples:8.0f} {embree / samples:10.0f} {(total - embree) / samples:10.0f}")
+EOF
+  exit 0
+fi
 echo "layer-profile.sh: perf record of penumbra-bench-render ${args[*]} (commit $(bench_commit "$root"))" >&2
 perf record -q -F 1000 --call-graph dwarf,16384 -o "$work/perf.data" \
   "$build/bin/penumbra-bench-render" "${args[@]}" > "$work/bench.txt"
