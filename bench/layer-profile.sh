@@ -24,7 +24,8 @@
 #             the minimal tracer takes only Lambertian triangles under area lights)
 #   --spp     samples per pixel of each render (default 16, or 8 with --instructions); --res film
 #             size (default 256, or 128 with --instructions). Much smaller renders trip the bench
-#             program's check that the two tracers' image means agree within 1 %.
+#             program's check that the two tracers' image means agree within 1 % (cornell-water
+#             needs --spp 16 with --instructions).
 #   --top     functions listed per renderer outside Embree (default 10; not with --instructions)
 #   --instructions  count instructions with callgrind instead of sampling with perf
 #   --keep    keep perf.data and the decoded stacks (or the callgrind parts) in DIR (default: a
