@@ -87,8 +87,8 @@ if [ "$instructions" = 1 ]; then
     --dump-after='penumbra::MinimalRenderResult penumbra::MinimalPathTracer::render_with<*' \
     "$build/bin/penumbra-bench-render" "${args[@]}" --rays 1000 > "$work/bench.txt" 2> "$work/valgrind.log" ||
     { tail -20 "$work/valgrind.log" >&2; echo "layer-profile.sh: the counted run failed" >&2; exit 1; }
-  for part in "$work"/parts.out.*; do
-    callgrind_annotate --inclusive=yes "$part" > "$part.txt" 2> /dev/null
+  for part in "$work"/parts.out.*[0-9]; do  # function totals only (--auto=no: no source listings)
+    callgrind_annotate --inclusive=yes --auto=no "$part" > "$part.txt" 2> /dev/null
   done
   "$py" - "$work" "$((res * res * spp))" <<'EOF'
 import glob, re, sys
@@ -110,7 +110,7 @@ for part in glob.glob(f"{work}/parts.out.*[0-9]"):
     total = int(re.search(r"^totals: (\d+)", text, re.M).group(1))
     embree = 0  # Embree's three entry points, inclusive (nothing else calls into Embree in a render)
     for line in open(part + ".txt"):
-        m = re.match(r"\s*([\d,]+) .*\?\?\?:rtc(Intersect1|Occluded1|Intersect8) ", line)
+        m = re.match(r"\s*([\d,]+) .*:rtc(Intersect1|Occluded1|Intersect8) ", line)
         if m:
             embree += int(m.group(1).replace(",", ""))
     rows[name] = (total, embree)
