@@ -93,11 +93,10 @@ if [ "$instructions" = 1 ]; then
   "$py" - "$work" "$((res * res * spp))" <<'EOF'
 import glob, re, sys
 
-# Each part's renderer, from the function whose end triggered its dump.
+# Each part's renderer, from the function whose end triggered its dump (in the table's order).
 work, samples = sys.argv[1], int(sys.argv[2])
-names = {"SampleIntegrator::render": "path integrator", "render_with<0u>": "minimal",
-         "render_with<1u>": "+ hit records", "render_with<3u>": "+ light sampling",
-         "render_with<7u>": "+ BSDF objects"}
+names = {"render_with<0u>": "minimal", "render_with<1u>": "+ hit records", "render_with<3u>": "+ light sampling",
+         "render_with<7u>": "+ BSDF objects", "SampleIntegrator::render": "path integrator"}
 rows = {}
 for part in glob.glob(f"{work}/parts.out.*[0-9]"):
     text = open(part).read()
@@ -116,7 +115,7 @@ for part in glob.glob(f"{work}/parts.out.*[0-9]"):
     rows[name] = (total, embree)
 print(f"instructions per pixel sample ({samples:,} samples per renderer)")
 print(f"{'renderer':20s} {'total':>8s} {'in Embree':>10s} {'elsewhere':>10s}")
-for name in ["minimal", "+ hit records", "+ light sampling", "+ BSDF objects", "path integrator"]:
+for name in names.values():
     if name in rows:
         total, embree = rows[name]
         print(f"{name:20s} {total / samples:8.0f} {embree / samples:10.0f} {(total - embree) / samples:10.0f}")
