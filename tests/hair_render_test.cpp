@@ -113,7 +113,8 @@ TEST(HairRender, HeadOfHairAgreesWithPbrtV4) {
 
 // Every integrator renders hair without NaN or infinity. Only sppm is held to agree with path: on
 // hair (no diffuse surface) its camera paths are a path tracer with the same next-event estimation
-// (4 seeds each, 4 combined standard errors asserted below 2 %, a 2 % offset rejected). bdpt and
+// (8 seeds each, 4 combined standard errors asserted below 2 %, a 2 % offset rejected; with 4 seeds the
+// seeds' own estimate of the standard error scattered so widely that it once came out at 2.1 %). bdpt and
 // light tracing reach a strand from the light, where the ray-facing ribbon faces the light ray and
 // not the camera ray, so their estimates of ray-facing strands differ from path's by several percent
 // (here +7 % and +4 %), as pbrt-v4's bdpt differs from its path (+4.9 % on this scene, 64x64, 1024 spp).
@@ -127,10 +128,11 @@ TEST(HairRender, EveryIntegratorRendersHairAndSppmAgreesWithPath) {
     EXPECT_GT(m.mean, 0.0) << integrator;
   }
   const auto res = std::make_pair(24, 24);
-  RenderMean path = render_mean(scene, "hair-path", 4, "path", res, 4096);
-  RenderMean sppm = render_mean(scene, "hair-sppm", 4, "sppm", res, 4096);
+  RenderMean path = render_mean(scene, "hair-path", 8, "path", res, 4096);
+  RenderMean sppm = render_mean(scene, "hair-sppm", 8, "sppm", res, 4096);
   double tol = 4.0 * std::sqrt(sqr(sppm.standard_error) + sqr(path.standard_error));
-  std::printf("[ measured ] sppm / path: %.4f (tolerance %.2f %%)\n", sppm.mean / path.mean, 100.0 * tol);
+  std::printf("[ measured ] sppm / path: %.4f (tolerance %.2f %%; standard errors: sppm %.2f %%, path %.2f %%)\n",
+              sppm.mean / path.mean, 100.0 * tol, 100.0 * sppm.standard_error, 100.0 * path.standard_error);
   EXPECT_LT(tol, 0.02);
   EXPECT_NEAR(sppm.mean / path.mean, 1.0, tol);
   EXPECT_GT(std::abs(sppm.mean / (1.02 * path.mean) - 1.0), tol);

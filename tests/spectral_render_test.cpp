@@ -165,9 +165,12 @@ TEST(SpectralFurnace, Sppm) {
 }
 
 // Two emitters of different colours (a small red one and a larger blue one) over a grey diffuse
-// floor: one bounce, linear in the emitters' spectra, so the spectral image has the RGB image's
-// colour. A light subpath's choice of emitter must not depend on the sample's wavelengths (it once
-// used the sampler dimension that the wavelengths came from: red 13 % low on veach-bidir).
+// floor, one bounce. A light subpath's choice of emitter must not depend on the sample's wavelengths
+// (it once used the sampler dimension that the wavelengths came from: red 13 % low on veach-bidir),
+// so bdpt and light tracing must give the spectral path tracer's image, within their noise. The
+// reference is the path tracer in the same spectral transport, not the RGB one: these saturated
+// emitters' spectra do not give back their RGB exactly (green 0.5 % low, measured over four seeds with
+// a standard error of 0.04 %), a gap no light-subpath error explains.
 TEST(SpectralRender, LightSubpathsFromColouredEmittersKeepTheirColour) {
   const std::string scene = R"(LookAt 0 0 3  0 0 0  0 1 0
 Camera "perspective" "float fov" [ 50 ]
@@ -204,15 +207,15 @@ AttributeEnd
     }
     return images;
   };
-  const std::vector<ImageRgb> reference = renders("path", false);
+  const std::vector<ImageRgb> reference = renders("path", true);
   for (const char* integrator : {"bdpt", "lighttracing"}) {
     const std::vector<ImageRgb> images = renders(integrator, true);
     for (int c = 0; c < 3; ++c) {
       SeedMean m = mean_over_seeds(4, [&](int seed) { return mean_channel(images[seed - 1], c); });
       SeedMean ref = mean_over_seeds(4, [&](int seed) { return mean_channel(reference[seed - 1], c); });
       double expected = ref.mean;
-      double tol = 4.0 * std::hypot(m.standard_error, ref.standard_error) + 3e-3 * expected;
-      std::printf("%s channel %d: spectral %.5f +- %.5f, RGB path %.5f +- %.5f\n", integrator, c, m.mean,
+      double tol = 4.0 * std::hypot(m.standard_error, ref.standard_error);
+      std::printf("%s channel %d: %.5f +- %.5f, path %.5f +- %.5f\n", integrator, c, m.mean,
                   m.standard_error, expected, ref.standard_error);
       EXPECT_NEAR(m.mean, expected, tol) << integrator << " channel " << c;
       EXPECT_GT(std::abs(1.02 * m.mean - expected), tol) << integrator << " channel " << c;

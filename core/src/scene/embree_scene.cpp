@@ -229,9 +229,7 @@ void EmbreeScene::set_lights(std::vector<const Light*> lights, std::vector<const
     power.push_back(std::max(0.f, luminance(lights_[i]->power())));
   }
   if (lights_.empty()) return;
-  light_distribution_ = Distribution1D(power);
-  light_pmfs_.resize(lights_.size());
-  for (size_t i = 0; i < lights_.size(); ++i) light_pmfs_[i] = light_distribution_.discrete_pmf(i);
+  light_table_ = AliasTable(power);
 }
 
 void EmbreeScene::commit() {
@@ -337,17 +335,15 @@ size_t EmbreeScene::triangle_count() const {
 
 std::optional<SampledLight> EmbreeScene::sample_light(float u) const {
   if (lights_.empty()) return std::nullopt;
-  if (lights_.size() == 1) return SampledLight{lights_[0], 1.f};  // what the distribution gives, without the search
-  size_t i = light_distribution_.sample_discrete(u);
-  float pmf = light_pmfs_[i];
+  size_t i = light_table_.sample(u);
+  float pmf = light_table_.pmf(i);
   if (pmf == 0.f) return std::nullopt;
   return SampledLight{lights_[i], pmf};
 }
 
 float EmbreeScene::light_pmf(const Light* light) const {
   if (lights_.empty() || !light) return 0.f;
-  size_t i = light->index();
-  return i < light_pmfs_.size() ? light_pmfs_[i] : 0.f;  // discrete_pmf()'s answer out of range
+  return light_table_.pmf(light->index());  // 0 for a light of another scene (index out of range)
 }
 
 static RTCRayHit make_rayhit(const Ray& ray) {

@@ -13,6 +13,7 @@
 #include "scene/sphere.h"
 #include "scene/surface_detail.h"
 #include "scene/triangle_mesh.h"
+#include "util/alias_table.h"
 
 #include <embree3/rtcore.h>
 
@@ -193,8 +194,7 @@ class EmbreeScene final : public Scene {
   std::vector<Geometry> geometries_;  // indexed by Embree geometry id
   std::vector<std::unique_ptr<GeometryUserData>> user_data_;  // Embree callbacks' (quadrics, cut-outs)
   std::vector<const Light*> lights_, infinite_;
-  Distribution1D light_distribution_;  // over lights_, proportional to luminance of power
-  std::vector<float> light_pmfs_;      // its discrete_pmf() of each light, looked up per light sample
+  AliasTable light_table_;  // over lights_, proportional to the luminance of their power
   std::unique_ptr<Camera> camera_;
   Bounds3 bounds_;
   float footprint_scale_ = 1.f;
