@@ -4,7 +4,6 @@
 #pragma once
 
 #include <penumbra/bsdf.h>
-#include <penumbra/sampling.h>
 #include <penumbra/scene.h>
 
 #include "scene/alpha_cutout.h"

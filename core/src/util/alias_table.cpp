@@ -21,9 +21,10 @@ AliasTable::AliasTable(std::span<const float> weights) {
   }
   pmf_.resize(n);
   bins_.resize(n);
-  // Each item's probability in units of one bin (mean 1). Items below 1 ("small") are topped up by
-  // one above ("large"), which then gives away what it filled and is sorted again.
-  std::vector<double> scaled(n);
+  // Each item's probability in units of one bin (mean 1), in place of its weight. Items below 1
+  // ("small") are topped up by one above ("large"), which then gives away what it filled and is
+  // sorted again.
+  std::vector<double>& scaled = w;
   std::vector<uint32_t> small, large;
   for (size_t i = 0; i < n; ++i) {
     pmf_[i] = float(w[i] / sum);

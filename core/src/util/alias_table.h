@@ -23,15 +23,14 @@ class AliasTable {
   /// when no weight is positive (or their sum is not finite), every item is equally likely.
   explicit AliasTable(std::span<const float> weights);
 
-  size_t size() const { return bins_.size(); }
   bool empty() const { return bins_.empty(); }
   /// An item drawn with probability pmf(i), for u in [0, 1). An item of zero weight is never drawn
   /// unless every weight is zero. The table must not be empty.
-  // Without branches: whether u keeps the bin's item or takes its alias is a coin flip of the bin's
-  // odds, which a branch predictor cannot learn (a branch here cost 4x the time for two lights). The
-  // index is 32-bit because a float converts to it in one instruction (to size_t in several, with a
-  // branch).
   size_t sample(float u) const {
+    // Without branches: whether u keeps the bin's item or takes its alias is a coin flip of the bin's
+    // odds, which a branch predictor cannot learn (a branch here cost 4x the time for two lights). The
+    // index is 32-bit because a float converts to it in one instruction (to size_t in several, with
+    // a branch).
     const uint32_t n = uint32_t(bins_.size());
     const float x = u * float(n);
     const uint32_t i = std::min(uint32_t(x), n - 1);  // min: u rounding up to 1 in the product
