@@ -346,6 +346,31 @@ TEST_F(PlyTest, IndexOutOfRange) {
   EXPECT_THAT(error(s), HasSubstr("vertex index -1 out of range in face 0"));
 }
 
+// CI's fuzzer found a NaN vertex index (a float index type) cast to an integer, which is undefined
+// behaviour. NaN and infinite indices and list lengths (an ascii count may read "nan") are now
+// errors, found by comparison alone.
+TEST_F(PlyTest, NonFiniteIndicesAndListLengthsAreErrors) {
+  std::string s = kAsciiQuad;
+  s.replace(s.find("list uchar int"), 14, "list uchar float");
+  ASSERT_EQ(read(s).indices.size(), 6u);  // control: float indices holding whole numbers read
+  for (const char* index : {"nan", "inf", "-inf"}) {
+    std::string bad = s;
+    bad.replace(bad.find("4 0 1 2 3"), 9, fmt::format("4 0 {} 2 3", index));
+    EXPECT_THAT(error(bad), HasSubstr(fmt::format("vertex index {} out of range in face 0", index)));
+  }
+  std::string half = s;
+  half.replace(half.find("4 0 1 2 3"), 9, "4 0 1.5 2 3");
+  EXPECT_THAT(error(half), HasSubstr("vertex index 1.5 in face 0 is not an integer"));
+  for (const char* count : {"nan", "2.5", "-1"}) {
+    std::string bad = s;
+    bad.replace(bad.find("4 0 1 2 3"), 1, count);
+    EXPECT_THAT(error(bad), HasSubstr(fmt::format("bad list length {} in property 'vertex_indices'", count)));
+  }
+  std::string endless = s;
+  endless.replace(endless.find("4 0 1 2 3"), 1, "inf");
+  EXPECT_THAT(error(endless), HasSubstr("claims inf items"));
+}
+
 TEST_F(PlyTest, NoFaces) {
   std::string s = kAsciiQuad;
   s.replace(s.find("element face 1"), 14, "element face 0");

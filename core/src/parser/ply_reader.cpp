@@ -188,7 +188,9 @@ class DataReader {
   // for a list the file cannot hold.
   size_t read_count(const Property& p) {
     double n = read(p.count_type);
-    if (n < 0 || n != static_cast<double>(static_cast<long long>(n)))
+    // Compared, never cast: a NaN count (a float count type) fails the first test, an infinite one the
+    // size test below.
+    if (!(n >= 0) || n != std::floor(n))
       ctx_.fail(fmt::format("bad list length {} in property '{}'", n, p.name));
     size_t left = data_.size() - pos_;
     size_t fits = format_ == Format::Ascii ? (left + 1) / 2 : left / size_of(p.type);
@@ -339,10 +341,10 @@ Scalar read_faces(const Element& e, DataReader& in, TriangleMeshData& mesh, Form
       poly.resize(in.read_count(p));
       for (int& idx : poly) {
         double d = in.read(p.type);
-        if (d < 0 || d > INT_MAX)
+        if (!(d >= 0 && d <= INT_MAX))  // NaN too (a float index type): it is never cast
           ctx.fail(fmt::format("vertex index {} out of range in face {}{}", d, i,
                                endianness_hint(format, p.type, d, vertices)));
-        if (d != static_cast<double>(static_cast<long long>(d)))
+        if (d != std::floor(d))
           ctx.fail(fmt::format("vertex index {} in face {} is not an integer", d, i));
         idx = static_cast<int>(d);
       }
