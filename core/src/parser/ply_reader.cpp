@@ -188,8 +188,8 @@ class DataReader {
   // for a list the file cannot hold.
   size_t read_count(const Property& p) {
     double n = read(p.count_type);
-    // Compared, never cast: a NaN count (a float count type) fails the first test, an infinite one the
-    // size test below.
+    // Compared, never cast: a NaN count (float count types are refused, but ascii data may spell it
+    // "nan") fails the first test, an infinite one the size test below.
     if (!(n >= 0) || n != std::floor(n))
       ctx_.fail(fmt::format("bad list length {} in property '{}'", n, p.name));
     size_t left = data_.size() - pos_;
