@@ -126,7 +126,6 @@ TEST(AliasTable, WithoutUsableWeightsEveryItemIsEquallyLikelyChiSquare) {
   EXPECT_EQ(mixed.pmf(0), 0.f);
   EXPECT_EQ(mixed.pmf(2), 0.f);
   EXPECT_FLOAT_EQ(mixed.pmf(3), 0.75f);
-  EXPECT_TRUE(AliasTable().empty());
   EXPECT_EQ(AliasTable().pmf(0), 0.f);
 }
 

@@ -23,7 +23,6 @@ class AliasTable {
   /// when no weight is positive (or their sum is not finite), every item is equally likely.
   explicit AliasTable(std::span<const float> weights);
 
-  bool empty() const { return bins_.empty(); }
   /// An item drawn with probability pmf(i), for u in [0, 1). An item of zero weight is never drawn
   /// unless every weight is zero. The table must not be empty.
   size_t sample(float u) const {
