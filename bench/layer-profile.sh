@@ -8,9 +8,10 @@
 # graphs (Embree is built without frame pointers, so only DWARF unwinding finds who called it), then
 # gives each sample to the renderer whose frame is nearest the sampled instruction on its stack: the
 # path integrator (its `Li` and the render loop around it, reported apart), one of the minimal
-# tracer's four layers (bench/minimal_path_tracer.cpp), or raw Embree's measurement. Every layer
-# renders the same pixel samples, so the counts compare directly. perf here samples the cpu-clock
-# (this project's virtual machine has no hardware counters), about once per millisecond.
+# tracer's four layers or its variant with robust ray origins (bench/minimal_path_tracer.cpp), or
+# raw Embree's measurement. Every layer renders the same pixel samples, so the counts compare
+# directly. perf here samples the cpu-clock (this project's virtual machine has no hardware
+# counters), about once per millisecond.
 #
 # With --instructions it counts instead of sampling: valgrind's callgrind runs the same round and
 # dumps its counts after each renderer's render, so each renderer's instructions per pixel sample,
@@ -95,7 +96,7 @@ import glob, re, sys
 
 # Each part's renderer, from the function whose end triggered its dump (in the table's order).
 work, samples = sys.argv[1], int(sys.argv[2])
-names = {"render_with<0u>": "minimal", "render_with<1u>": "+ hit records", "render_with<3u>": "+ light sampling",
+names = {"render_with<0u>": "minimal", "render_with<8u>": "minimal, robust origins", "render_with<1u>": "+ hit records", "render_with<3u>": "+ light sampling",
          "render_with<7u>": "+ BSDF objects", "SampleIntegrator::render": "path integrator"}
 rows = {}
 for part in glob.glob(f"{work}/parts.out.*[0-9]"):
@@ -134,6 +135,7 @@ import collections, sys
 # The renderer a sample belongs to: the first of these frames found walking up from the sampled
 # instruction. The render loop's own frame comes after Li's, so Li's callees count as Li's.
 owners = [("Li<0u>", "minimal"), ("render_with<0u>", "minimal"),
+          ("Li<8u>", "minimal, robust origins"), ("render_with<8u>", "minimal, robust origins"),
           ("Li<1u>", "+ hit records"), ("render_with<1u>", "+ hit records"),
           ("Li<3u>", "+ light sampling"), ("render_with<3u>", "+ light sampling"),
           ("Li<7u>", "+ BSDF objects"), ("render_with<7u>", "+ BSDF objects"),

@@ -68,6 +68,8 @@ MinimalPathTracer::MinimalPathTracer(const EmbreeScene& scene, int max_depth, in
       tri_lights_.push_back(light);
       emitter_pmf_.push_back(pmf);
       triangles_.push_back(t);
+      other_vertices_.push_back(p1);
+      other_vertices_.push_back(p2);
     }
   }
   if (emitters_.empty()) throw Error("the minimal path tracer needs an area light");
@@ -77,8 +79,11 @@ MinimalPathTracer::MinimalPathTracer(const EmbreeScene& scene, int max_depth, in
 
 template <unsigned kLayers>
 Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed, uint64_t* rays) const {
-  // Layers stack in order (render() builds 0, 1, 3 and 7): Light::pdf_li() reads the hit record.
+  // Layers stack in order (render() builds 0, 1, 3 and 7, and kRobust alone): Light::pdf_li() reads
+  // the hit record.
   static_assert((kLayers & kLights) == 0 || (kLayers & kHits) != 0, "kLights needs kHits");
+  static_assert((kLayers & kRobust) == 0 || kLayers == kRobust, "kRobust goes alone");
+  constexpr bool robust = (kLayers & kRobust) != 0;
   Pcg32 rng(stream, seed);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
@@ -96,6 +101,7 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
     }();
     uint32_t index;
     float t;
+    Vec2 b12(0.f);  // Embree's barycentrics of the hit (kRobust)
     if constexpr ((kLayers & kHits) != 0) {
       ++*rays;
       if (!si) break;
@@ -113,9 +119,21 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
       index = first_triangle_[rh.hit.geomID] + rh.hit.primID;
       t = rh.ray.tfar;
+      b12 = Vec2(rh.hit.u, rh.hit.v);
     }
     const Triangle& tri = triangles_[index];
-    const Vec3 p = (kLayers & kHits) != 0 ? si->p : ray.o + t * ray.d;
+    // kRobust: the point from the barycentrics and its error bound, as TriangleMesh::surface() makes them.
+    Vec3 p, p_error(0.f);
+    if constexpr ((kLayers & kHits) != 0) {
+      p = si->p;
+    } else if constexpr (robust) {
+      const float b0 = 1.f - b12.x - b12.y;
+      const Vec3 &p1 = other_vertices_[2 * index], &p2 = other_vertices_[2 * index + 1];
+      p = b0 * tri.p0 + b12.x * p1 + b12.y * p2;
+      p_error = error_gamma(7) * (abs_each(b0 * tri.p0) + abs_each(b12.x * p1) + abs_each(b12.y * p2));
+    } else {
+      p = ray.o + t * ray.d;
+    }
     const float cos_o = glm::dot(tri.n, ray.d);  // < 0: the ray arrives on the side of n
     const Rgb& le = cos_o < 0.f ? tri.le_front : tri.le_back;
     if (le.r > 0.f || le.g > 0.f || le.b > 0.f) {
@@ -184,10 +202,16 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
         occluded = scene_.occluded(si->spawn_ray_to(q, n_light));
       } else {
         RTCRay shadow;
-        Vec3 to = q - p;
-        shadow.org_x = p.x, shadow.org_y = p.y, shadow.org_z = p.z, shadow.tnear = kTnear / glm::length(to);
-        shadow.dir_x = to.x, shadow.dir_y = to.y, shadow.dir_z = to.z, shadow.time = 0.f;
-        shadow.tfar = 1.f - 1e-4f, shadow.mask = 0xFFFFFFFFu, shadow.id = 0, shadow.flags = 0;
+        if constexpr (robust) {  // both ends offset past their error bounds, as SurfaceInteraction::spawn_ray_to()
+          Ray r = spawn_ray_to(p, p_error, tri.n, q, point_error_bound(q), n_light);
+          shadow.org_x = r.o.x, shadow.org_y = r.o.y, shadow.org_z = r.o.z, shadow.tnear = 0.f;
+          shadow.dir_x = r.d.x, shadow.dir_y = r.d.y, shadow.dir_z = r.d.z, shadow.tfar = r.tmax;
+        } else {
+          Vec3 to = q - p;
+          shadow.org_x = p.x, shadow.org_y = p.y, shadow.org_z = p.z, shadow.tnear = kTnear / glm::length(to);
+          shadow.dir_x = to.x, shadow.dir_y = to.y, shadow.dir_z = to.z, shadow.tfar = 1.f - 1e-4f;
+        }
+        shadow.time = 0.f, shadow.mask = 0xFFFFFFFFu, shadow.id = 0, shadow.flags = 0;
         rtcOccluded1(scene_.rtc_scene(), &ctx, &shadow);
         occluded = shadow.tfar < 0.f;
       }
@@ -215,8 +239,9 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
     const Vec3 d = frame.to_world(w_local);
     if constexpr ((kLayers & kLights) != 0) prev = LightSampleContext{p, n, true};
     if constexpr ((kLayers & kHits) != 0) ray = si->spawn_ray(d);
+    else if constexpr (robust) ray = Ray{offset_ray_origin(p, p_error, tri.n, d), d, Infinity};
     else ray = Ray{p, d, Infinity};
-    tnear = kTnear;
+    tnear = robust ? 0.f : kTnear;
     if (depth + 1 >= rr_depth_) {
       float q_end = std::max(0.f, 1.f - max_component(beta));
       if (u_rr < q_end) break;
@@ -264,7 +289,8 @@ MinimalRenderResult MinimalPathTracer::render(Point2i res, int spp, int threads,
     case kHits: return render_with<kHits>(res, spp, threads, seed);
     case kHits | kLights: return render_with<kHits | kLights>(res, spp, threads, seed);
     case kHits | kLights | kBsdf: return render_with<kHits | kLights | kBsdf>(res, spp, threads, seed);
-    default: throw Error(fmt::format("minimal path tracer: layers {} are not built (0, 1, 3 and 7 are)", layers));
+    case kRobust: return render_with<kRobust>(res, spp, threads, seed);
+    default: throw Error(fmt::format("minimal path tracer: layers {} are not built (0, 1, 3, 7 and 8 are)", layers));
   }
 }
 

@@ -14,6 +14,7 @@
 // difference in time at the same estimator: kHits traces through Scene::intersect() and occluded()
 // (hit records, robust ray offsets), kLights samples lights through Scene::sample_light() and
 // Light::sample_li() / pdf_li(), kBsdf evaluates and samples the Bsdf objects in the shading frame.
+// kRobust instead keeps the minimal tracer and gives it only the renderer's robust ray origins.
 #pragma once
 
 #include "scene/embree_scene.h"
@@ -25,7 +26,10 @@
 
 namespace penumbra {
 
-enum MinimalLayers : unsigned { kMinimalOnly = 0, kHits = 1, kLights = 2, kBsdf = 4 };
+// kRobust is the minimal tracer alone with the renderer's robust ray origins instead of a fixed tnear:
+// hit points from the barycentrics with their error bounds, secondary and shadow rays offset past
+// them (penumbra/interaction.h), everything else as kMinimalOnly. It goes alone, not with the layers.
+enum MinimalLayers : unsigned { kMinimalOnly = 0, kHits = 1, kLights = 2, kBsdf = 4, kRobust = 8 };
 
 struct MinimalRenderResult {
   double seconds = 0.0;  // rendering only
@@ -60,6 +64,7 @@ class MinimalPathTracer {
   int max_depth_, rr_depth_;
   std::vector<uint32_t> first_triangle_;  // per Embree geometry id, into triangles_
   std::vector<Triangle> triangles_;
+  std::vector<Vec3> other_vertices_;      // p1 and p2 of each triangle, for kRobust's hit points
   std::vector<const Light*> tri_lights_;  // per triangle, null where it does not emit
   std::vector<uint32_t> emitters_;        // indices into triangles_
   std::vector<float> emitter_cdf_;        // by the lights' power, emitters_.size() + 1 entries

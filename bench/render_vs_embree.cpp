@@ -12,7 +12,9 @@
 //                     at a time and as 8-wide packets
 //   --minimal         each round also renders with bench/minimal_path_tracer.h, the same estimator written
 //                     straight on Embree (Lambertian triangles and area lights only), and reports its ray
-//                     rate and ratio to raw Embree: what the renderer's ratio could be without its overheads
+//                     rate and ratio to raw Embree: what the renderer's ratio could be without its overheads;
+//                     and once more with the renderer's robust ray origins (error-bounded offsets) instead
+//                     of a fixed tnear, the one overhead a correct renderer cannot drop
 //   --json            one JSON object per thread count on stdout instead of the table
 #include "minimal_path_tracer.h"
 #include "number_options.h"
@@ -252,6 +254,7 @@ int main(int argc, char** argv) {
     struct Rounds {
       std::vector<double> path_mrays, path_msamples, closest, shadow, mixed, ratio;
       std::vector<double> minimal_mrays, minimal_ratio;  // with --minimal
+      std::vector<double> robust_ns, robust_ratio;       // the minimal tracer with robust ray origins
       std::vector<double> path_ns, layer_ns[4];          // nanoseconds per sample: path, and the layers
       double path_rays_per_sample = 0, path_mean = 0, minimal_rays_per_sample = 0, minimal_mean = 0;
     };
@@ -292,13 +295,23 @@ int main(int argc, char** argv) {
             MinimalRenderResult layered = minimal_tracer->render(Point2i(res, res), spp, threads, round, kLayerSets[k]);
             r.layer_ns[k].push_back(layered.seconds / layered.samples * 1e9);
           }
+          MinimalRenderResult robust = minimal_tracer->render(Point2i(res, res), spp, threads, round, kRobust);
+          if (r.path_mean > 0 && std::abs(robust.mean - r.path_mean) > 0.01 * r.path_mean)
+            throw Error(fmt::format("the minimal path tracer with robust ray origins has image mean {:.5f}, the path "
+                                    "integrator {:.5f}: they differ by more than 1 % on {}",
+                                    robust.mean, r.path_mean, scene_file));
+          r.robust_ns.push_back(robust.seconds / robust.samples * 1e9);
+          r.robust_ratio.push_back(robust.rays / robust.seconds * 1e-6);  // divided by raw Embree below
         }
         RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
         r.closest.push_back(raw.closest_mrays);
         r.shadow.push_back(raw.shadow_mrays);
         r.mixed.push_back(raw.mixed_mrays);
         if (!raw_only) r.ratio.push_back(r.path_mrays.back() / raw.mixed_mrays);
-        if (minimal_tracer) r.minimal_ratio.push_back(r.minimal_mrays.back() / raw.mixed_mrays);
+        if (minimal_tracer) {
+          r.minimal_ratio.push_back(r.minimal_mrays.back() / raw.mixed_mrays);
+          r.robust_ratio.back() /= raw.mixed_mrays;
+        }
       }
       return r;
     };
@@ -321,6 +334,7 @@ int main(int argc, char** argv) {
         if (minimal) {
           j["minimal_mrays_per_second"] = median(r.minimal_mrays);
           j["minimal_ratio"] = median(r.minimal_ratio);
+          j["minimal_robust_ratio"] = median(r.robust_ratio);
           j["path_rays_per_sample"] = r.path_rays_per_sample;
           j["minimal_rays_per_sample"] = r.minimal_rays_per_sample;
           j["path_image_mean"] = r.path_mean;
@@ -357,9 +371,13 @@ int main(int argc, char** argv) {
                    100.0 * *std::min_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
                    100.0 * *std::max_element(r.minimal_ratio.begin(), r.minimal_ratio.end()),
                    r.minimal_rays_per_sample, r.path_rays_per_sample, r.minimal_mean, r.path_mean);
-        fmt::print("{:>7} ns per sample (medians): minimal {:.0f}, + hit records {:.0f}, + light sampling {:.0f}, "
-                   "+ BSDF objects {:.0f}, path integrator {:.0f}\n", threads, median(r.layer_ns[0]),
-                   median(r.layer_ns[1]), median(r.layer_ns[2]), median(r.layer_ns[3]), median(r.path_ns));
+        fmt::print("{:>7} minimal path tracer with robust ray origins: ratio {:.1f}% [{:.1f}, {:.1f}]\n", threads,
+                   100.0 * median(r.robust_ratio), 100.0 * *std::min_element(r.robust_ratio.begin(), r.robust_ratio.end()),
+                   100.0 * *std::max_element(r.robust_ratio.begin(), r.robust_ratio.end()));
+        fmt::print("{:>7} ns per sample (medians): minimal {:.0f} (robust origins {:.0f}), + hit records {:.0f}, "
+                   "+ light sampling {:.0f}, + BSDF objects {:.0f}, path integrator {:.0f}\n", threads,
+                   median(r.layer_ns[0]), median(r.robust_ns), median(r.layer_ns[1]), median(r.layer_ns[2]),
+                   median(r.layer_ns[3]), median(r.path_ns));
       }
     }
   } catch (const Error& e) {
