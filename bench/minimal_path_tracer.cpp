@@ -14,7 +14,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
+#include <immintrin.h>
 
 namespace penumbra {
 
@@ -108,10 +110,12 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
       index = first_triangle_[si->shape_id] + si->prim_id;
       t = si->t;
     } else {
+      // In whole 16-byte stores, as the renderer's EmbreeScene writes its queries: Embree loads
+      // origin and direction as 16-byte vectors, which smaller stores still in flight cannot forward.
       RTCRayHit rh;
-      rh.ray.org_x = ray.o.x, rh.ray.org_y = ray.o.y, rh.ray.org_z = ray.o.z, rh.ray.tnear = tnear;
-      rh.ray.dir_x = ray.d.x, rh.ray.dir_y = ray.d.y, rh.ray.dir_z = ray.d.z, rh.ray.time = 0.f;
-      rh.ray.tfar = Infinity, rh.ray.mask = 0xFFFFFFFFu, rh.ray.id = 0, rh.ray.flags = 0;
+      _mm_storeu_ps(&rh.ray.org_x, _mm_setr_ps(ray.o.x, ray.o.y, ray.o.z, tnear));
+      _mm_storeu_ps(&rh.ray.dir_x, _mm_setr_ps(ray.d.x, ray.d.y, ray.d.z, 0.f));
+      _mm_storeu_ps(&rh.ray.tfar, _mm_setr_ps(Infinity, std::bit_cast<float>(0xFFFFFFFFu), 0.f, 0.f));
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(scene_.rtc_scene(), &ctx, &rh);
@@ -202,16 +206,17 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
         occluded = scene_.occluded(si->spawn_ray_to(q, n_light));
       } else {
         RTCRay shadow;
+        Vec3 o, to;
+        float near, far;
         if constexpr (robust) {  // both ends offset past their error bounds, as SurfaceInteraction::spawn_ray_to()
           Ray r = spawn_ray_to(p, p_error, tri.n, q, point_error_bound(q), n_light);
-          shadow.org_x = r.o.x, shadow.org_y = r.o.y, shadow.org_z = r.o.z, shadow.tnear = 0.f;
-          shadow.dir_x = r.d.x, shadow.dir_y = r.d.y, shadow.dir_z = r.d.z, shadow.tfar = r.tmax;
+          o = r.o, to = r.d, near = 0.f, far = r.tmax;
         } else {
-          Vec3 to = q - p;
-          shadow.org_x = p.x, shadow.org_y = p.y, shadow.org_z = p.z, shadow.tnear = kTnear / glm::length(to);
-          shadow.dir_x = to.x, shadow.dir_y = to.y, shadow.dir_z = to.z, shadow.tfar = 1.f - 1e-4f;
+          o = p, to = q - p, near = kTnear / glm::length(to), far = 1.f - 1e-4f;
         }
-        shadow.time = 0.f, shadow.mask = 0xFFFFFFFFu, shadow.id = 0, shadow.flags = 0;
+        _mm_storeu_ps(&shadow.org_x, _mm_setr_ps(o.x, o.y, o.z, near));
+        _mm_storeu_ps(&shadow.dir_x, _mm_setr_ps(to.x, to.y, to.z, 0.f));
+        _mm_storeu_ps(&shadow.tfar, _mm_setr_ps(far, std::bit_cast<float>(0xFFFFFFFFu), 0.f, 0.f));
         rtcOccluded1(scene_.rtc_scene(), &ctx, &shadow);
         occluded = shadow.tfar < 0.f;
       }
