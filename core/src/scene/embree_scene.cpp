@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include <bit>
+#include <cstddef>
 #include <immintrin.h>
 
 namespace penumbra {
@@ -353,9 +354,13 @@ float EmbreeScene::light_pmf(const Light* light) const {
 // their data from the stores and wait until the stores reach the cache: a stall at the start of
 // every ray, which raw Embree, tracing rays built long before, never has. 4 % of the path tracer's
 // time on the Cornell box (docs/benchmarks.md, "Rays handed to Embree in whole vectors").
-static RTCRayHit make_rayhit(const Ray& ray) {
+static RTCRayHit make_rayhit(const Ray& ray, float tnear = 0.f) {
+  static_assert(offsetof(RTCRay, tnear) == offsetof(RTCRay, org_x) + 12 &&
+                    offsetof(RTCRay, time) == offsetof(RTCRay, dir_x) + 12 &&
+                    offsetof(RTCRay, flags) == offsetof(RTCRay, tfar) + 12,
+                "each 16-byte store below covers four of RTCRay's fields, in Embree 3's order");
   RTCRayHit rh;
-  _mm_storeu_ps(&rh.ray.org_x, _mm_setr_ps(ray.o.x, ray.o.y, ray.o.z, 0.f));  // tnear 0
+  _mm_storeu_ps(&rh.ray.org_x, _mm_setr_ps(ray.o.x, ray.o.y, ray.o.z, tnear));
   _mm_storeu_ps(&rh.ray.dir_x, _mm_setr_ps(ray.d.x, ray.d.y, ray.d.z, 0.f));  // time 0
   _mm_storeu_ps(&rh.ray.tfar, _mm_setr_ps(ray.tmax, std::bit_cast<float>(0xFFFFFFFFu), 0.f, 0.f));  // mask, id, flags
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -375,8 +380,7 @@ inline RTCRayHit EmbreeScene::embree_ray(const Ray& ray, float* t_scale, float* 
   float len = glm::length(ray.d);
   if (!(len > 0.f) || !std::isfinite(len)) return make_rayhit(ray);
   Vec3 d = ray.d / len;
-  RTCRayHit rh = make_rayhit(Ray{ray.o - curve_back_ * d, d, ray.tmax * len + curve_back_});
-  rh.ray.tnear = curve_back_;
+  RTCRayHit rh = make_rayhit(Ray{ray.o - curve_back_ * d, d, ray.tmax * len + curve_back_}, curve_back_);
   *t_scale = len;
   *t_shift = curve_back_;
   return rh;
