@@ -96,7 +96,8 @@ import glob, re, sys
 
 # Each part's renderer, from the function whose end triggered its dump (in the table's order).
 work, samples = sys.argv[1], int(sys.argv[2])
-names = {"render_with<0u>": "minimal", "render_with<8u>": "minimal, robust origins", "render_with<1u>": "+ hit records", "render_with<3u>": "+ light sampling",
+names = {"render_with<0u>": "minimal", "render_with<8u>": "minimal, robust origins",
+         "render_with<1u>": "+ hit records", "render_with<3u>": "+ light sampling",
          "render_with<7u>": "+ BSDF objects", "SampleIntegrator::render": "path integrator"}
 rows = {}
 for part in glob.glob(f"{work}/parts.out.*[0-9]"):

@@ -14,9 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <bit>
 #include <chrono>
-#include <immintrin.h>
 
 namespace penumbra {
 
@@ -110,14 +108,7 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
       index = first_triangle_[si->shape_id] + si->prim_id;
       t = si->t;
     } else {
-      // In whole 16-byte stores, as the renderer's EmbreeScene writes its queries: Embree loads
-      // origin and direction as 16-byte vectors, which smaller stores still in flight cannot forward.
-      RTCRayHit rh;
-      _mm_storeu_ps(&rh.ray.org_x, _mm_setr_ps(ray.o.x, ray.o.y, ray.o.z, tnear));
-      _mm_storeu_ps(&rh.ray.dir_x, _mm_setr_ps(ray.d.x, ray.d.y, ray.d.z, 0.f));
-      _mm_storeu_ps(&rh.ray.tfar, _mm_setr_ps(Infinity, std::bit_cast<float>(0xFFFFFFFFu), 0.f, 0.f));
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      RTCRayHit rh = embree_query(Ray{ray.o, ray.d, Infinity}, tnear);  // as the renderer writes its queries
       rtcIntersect1(scene_.rtc_scene(), &ctx, &rh);
       ++*rays;
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
@@ -205,20 +196,15 @@ Rgb MinimalPathTracer::Li(const Ray& camera_ray, uint64_t stream, uint64_t seed,
       if constexpr ((kLayers & kHits) != 0) {
         occluded = scene_.occluded(si->spawn_ray_to(q, n_light));
       } else {
-        RTCRay shadow;
-        Vec3 o, to;
-        float near, far;
+        RTCRayHit shadow;
         if constexpr (robust) {  // both ends offset past their error bounds, as SurfaceInteraction::spawn_ray_to()
-          Ray r = spawn_ray_to(p, p_error, tri.n, q, point_error_bound(q), n_light);
-          o = r.o, to = r.d, near = 0.f, far = r.tmax;
+          shadow = embree_query(spawn_ray_to(p, p_error, tri.n, q, point_error_bound(q), n_light));
         } else {
-          o = p, to = q - p, near = kTnear / glm::length(to), far = 1.f - 1e-4f;
+          const Vec3 to = q - p;
+          shadow = embree_query(Ray{p, to, 1.f - 1e-4f}, kTnear / glm::length(to));
         }
-        _mm_storeu_ps(&shadow.org_x, _mm_setr_ps(o.x, o.y, o.z, near));
-        _mm_storeu_ps(&shadow.dir_x, _mm_setr_ps(to.x, to.y, to.z, 0.f));
-        _mm_storeu_ps(&shadow.tfar, _mm_setr_ps(far, std::bit_cast<float>(0xFFFFFFFFu), 0.f, 0.f));
-        rtcOccluded1(scene_.rtc_scene(), &ctx, &shadow);
-        occluded = shadow.tfar < 0.f;
+        rtcOccluded1(scene_.rtc_scene(), &ctx, &shadow.ray);
+        occluded = shadow.ray.tfar < 0.f;
       }
       ++*rays;
       if (!occluded) L += beta * f_cos * le_l * (power_heuristic(1, light_pdf, 1, pdf_bsdf) / light_pdf);

@@ -254,7 +254,7 @@ int main(int argc, char** argv) {
     struct Rounds {
       std::vector<double> path_mrays, path_msamples, closest, shadow, mixed, ratio;
       std::vector<double> minimal_mrays, minimal_ratio;  // with --minimal
-      std::vector<double> robust_ns, robust_ratio;       // the minimal tracer with robust ray origins
+      std::vector<double> robust_mrays, robust_ratio, robust_ns;  // the minimal tracer with robust ray origins
       std::vector<double> path_ns, layer_ns[4];          // nanoseconds per sample: path, and the layers
       double path_rays_per_sample = 0, path_mean = 0, minimal_rays_per_sample = 0, minimal_mean = 0;
     };
@@ -301,7 +301,7 @@ int main(int argc, char** argv) {
                                     "integrator {:.5f}: they differ by more than 1 % on {}",
                                     robust.mean, r.path_mean, scene_file));
           r.robust_ns.push_back(robust.seconds / robust.samples * 1e9);
-          r.robust_ratio.push_back(robust.rays / robust.seconds * 1e-6);  // divided by raw Embree below
+          r.robust_mrays.push_back(robust.rays / robust.seconds * 1e-6);
         }
         RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
         r.closest.push_back(raw.closest_mrays);
@@ -310,7 +310,7 @@ int main(int argc, char** argv) {
         if (!raw_only) r.ratio.push_back(r.path_mrays.back() / raw.mixed_mrays);
         if (minimal_tracer) {
           r.minimal_ratio.push_back(r.minimal_mrays.back() / raw.mixed_mrays);
-          r.robust_ratio.back() /= raw.mixed_mrays;
+          r.robust_ratio.push_back(r.robust_mrays.back() / raw.mixed_mrays);
         }
       }
       return r;

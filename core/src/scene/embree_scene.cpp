@@ -7,8 +7,6 @@
 #include <fmt/core.h>
 
 #include <bit>
-#include <cstddef>
-#include <immintrin.h>
 
 namespace penumbra {
 
@@ -348,26 +346,6 @@ float EmbreeScene::light_pmf(const Light* light) const {
   return light_table_.pmf(light->index());  // 0 for a light of another scene (index out of range)
 }
 
-// The query is written in whole 16-byte stores because Embree starts a traversal by loading the
-// origin with tnear, and the direction with time, as 16-byte vectors. Written field by field (three
-// or four smaller stores each, still in flight when Embree loads them), those loads cannot take
-// their data from the stores and wait until the stores reach the cache: a stall at the start of
-// every ray, which raw Embree, tracing rays built long before, never has. 4 % of the path tracer's
-// time on the Cornell box (docs/benchmarks.md, "Rays handed to Embree in whole vectors").
-static RTCRayHit make_rayhit(const Ray& ray, float tnear = 0.f) {
-  static_assert(offsetof(RTCRay, tnear) == offsetof(RTCRay, org_x) + 12 &&
-                    offsetof(RTCRay, time) == offsetof(RTCRay, dir_x) + 12 &&
-                    offsetof(RTCRay, flags) == offsetof(RTCRay, tfar) + 12,
-                "each 16-byte store below covers four of RTCRay's fields, in Embree 3's order");
-  RTCRayHit rh;
-  _mm_storeu_ps(&rh.ray.org_x, _mm_setr_ps(ray.o.x, ray.o.y, ray.o.z, tnear));
-  _mm_storeu_ps(&rh.ray.dir_x, _mm_setr_ps(ray.d.x, ray.d.y, ray.d.z, 0.f));  // time 0
-  _mm_storeu_ps(&rh.ray.tfar, _mm_setr_ps(ray.tmax, std::bit_cast<float>(0xFFFFFFFFu), 0.f, 0.f));  // mask, id, flags
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  return rh;
-}
-
 // Embree ignores curve hits closer to the ray's origin than about two radii (its self-intersection
 // avoidance), which would hide a neighbouring strand that pbrt-v4 sees. With curves in the scene the
 // ray reaches Embree with a unit direction, its origin moved back along it by `back` (more than two of
@@ -376,11 +354,11 @@ static RTCRayHit make_rayhit(const Ray& ray, float tnear = 0.f) {
 inline RTCRayHit EmbreeScene::embree_ray(const Ray& ray, float* t_scale, float* t_shift) const {
   *t_scale = 1.f;
   *t_shift = 0.f;
-  if (!has_curves_) return make_rayhit(ray);
+  if (!has_curves_) return embree_query(ray);
   float len = glm::length(ray.d);
-  if (!(len > 0.f) || !std::isfinite(len)) return make_rayhit(ray);
+  if (!(len > 0.f) || !std::isfinite(len)) return embree_query(ray);
   Vec3 d = ray.d / len;
-  RTCRayHit rh = make_rayhit(Ray{ray.o - curve_back_ * d, d, ray.tmax * len + curve_back_}, curve_back_);
+  RTCRayHit rh = embree_query(Ray{ray.o - curve_back_ * d, d, ray.tmax * len + curve_back_}, curve_back_);
   *t_scale = len;
   *t_shift = curve_back_;
   return rh;
@@ -417,7 +395,7 @@ void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::opti
     }
     return;
   }
-  // Each lane is the ray intersect() would trace (make_rayhit()); empty lanes are masked off.
+  // Each lane is the ray intersect() would trace (embree_query()); empty lanes are masked off.
   alignas(32) int valid[8];
   alignas(32) RTCRayHit8 packet;
   unsigned spheres[8];
@@ -426,7 +404,7 @@ void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::opti
   for (unsigned i = 0; i < 8; ++i) {
     const Ray* r = i < rays.size() ? rays[i] : nullptr;
     valid[i] = r ? -1 : 0;
-    RTCRayHit one = make_rayhit(r ? *r : Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f), -Infinity});
+    RTCRayHit one = embree_query(r ? *r : Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f), -Infinity});
     spheres[i] = r && !direct_spheres_.empty() ? nearest_direct_sphere(*r, &one.ray.tfar) : RTC_INVALID_GEOMETRY_ID;
     RTCRayN_org_x(lanes, 8, i) = one.ray.org_x, RTCRayN_org_y(lanes, 8, i) = one.ray.org_y;
     RTCRayN_org_z(lanes, 8, i) = one.ray.org_z, RTCRayN_tnear(lanes, 8, i) = one.ray.tnear;
