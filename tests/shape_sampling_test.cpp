@@ -120,11 +120,41 @@ ChiSquareResult triangle_chi_square(const TriangleMesh& mesh, double z_min) {
 
 }  // namespace
 
-// Subtends about 1.1 sr: sampled uniformly in solid angle (Arvo's spherical triangle sampling).
+namespace {
+
+// Whether the triangle's density seen from the origin is the same towards its centroid and towards a
+// point near its first vertex: uniform in solid angle (spherical sampling) or not (by area).
+bool uniform_in_solid_angle(const TriangleMesh& mesh) {
+  Triangle tri(&mesh, 0);
+  ShapeSampleContext ctx{Vec3(0.f), Vec3(0.f)};
+  Vec3 n = mesh.geometric_normal(0, Vec3(1 / 3.f));
+  Vec3 centroid = (mesh.P[0] + mesh.P[1] + mesh.P[2]) / 3.f, corner = 0.8f * mesh.P[0] + 0.2f * centroid;
+  float a = tri.pdf_solid_angle(ctx, glm::normalize(centroid), centroid, n);
+  float b = tri.pdf_solid_angle(ctx, glm::normalize(corner), corner, n);
+  return std::abs(a - b) <= 1e-4f * a;
+}
+
+}  // namespace
+
+// Subtends about 1.1 sr, its front towards the origin: sampled uniformly in solid angle (Arvo's
+// spherical triangle sampling).
 TEST(TriangleSampling, SphericalSamplingMatchesPdfChiSquare) {
   TriangleMesh mesh;
   mesh.P = {Vec3(-1, -0.5f, 1), Vec3(1.5f, -0.3f, 1.2f), Vec3(0.2f, 1.4f, 0.8f)};
+  mesh.indices = {0, 2, 1};  // the winding's normal faces the origin
+  ASSERT_TRUE(uniform_in_solid_angle(mesh)) << "the spherical sampler is not the one in use";
+  ChiSquareResult r = triangle_chi_square(mesh, 0.3);
+  EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
+  EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);
+}
+
+// The same triangle seen from behind (its normal faces away from the origin), where a one-sided
+// emitter sends nothing: sampled by area, and the pdf makes the same choice.
+TEST(TriangleSampling, TriangleSeenFromBehindUsesAreaSamplingChiSquare) {
+  TriangleMesh mesh;
+  mesh.P = {Vec3(-1, -0.5f, 1), Vec3(1.5f, -0.3f, 1.2f), Vec3(0.2f, 1.4f, 0.8f)};
   mesh.indices = {0, 1, 2};
+  ASSERT_FALSE(uniform_in_solid_angle(mesh)) << "seen from behind, the triangle is still sampled spherically";
   ChiSquareResult r = triangle_chi_square(mesh, 0.3);
   EXPECT_TRUE(r.passes(kAlpha)) << r.summary();
   EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);

@@ -1,6 +1,8 @@
 #include "scene/embree_scene.h"
 
 #include "render/ray_counter.h"
+#include "scene/triangle_surface.h"
+#include "util/cpu_clones.h"
 
 #include <penumbra/error.h>
 
@@ -12,6 +14,30 @@ namespace penumbra {
 
 static void embree_error(void*, RTCError code, const char* message) {
   throw Error(fmt::format("Embree error {}: {}", static_cast<int>(code), message ? message : ""));
+}
+
+// The surface at a hit Embree reported at distance t along `ray` (in the ray's own units). The
+// common case, a triangle that is not instanced and needs no tangent frame, is inlined into the
+// functions that trace (intersect(), intersect_coherent()), with the triangle's surface: the record's
+// fields are then written once, where its initialisation is, and no call is made for it.
+[[gnu::always_inline]] inline void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit,
+                                                         SurfaceInteraction& si) const {
+  if (hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
+    const Geometry& g = geometries_[hit.geomID];
+    if (g.mesh && !g.tangent_frame) {
+      si.t = t;
+      si.wo = -glm::normalize(ray.d);
+      si.shape_id = hit.geomID;
+      si.prim_id = hit.primID;
+      si.bsdf = g.bsdf;
+      si.media = g.media;
+      if (!g.lights.empty()) si.area_light = g.lights[hit.primID];
+      g.mesh->fill_surface(hit.primID, Vec3(1.f - hit.u - hit.v, hit.u, hit.v), Vec3(hit.Ng_x, hit.Ng_y, hit.Ng_z), si);
+      si.shading = Frame(si.ns);
+      return;
+    }
+  }
+  fill_hit_general(ray, t, hit, si);
 }
 
 EmbreeScene::EmbreeScene() {
@@ -387,7 +413,8 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
   return out;
 }
 
-void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::optional<SurfaceInteraction>* hits) const {
+void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays,
+                                                          std::optional<SurfaceInteraction>* hits) const {
   if (has_curves_ || rays.size() > 8) {  // curves move each ray's origin (embree_ray()): one at a time
     for (size_t i = 0; i < rays.size(); ++i) {
       if (rays[i]) hits[i] = intersect(*rays[i]);
@@ -439,8 +466,8 @@ EmbreeScene::GeometryView EmbreeScene::geometry_view(unsigned id, unsigned prim)
   return {g.mesh, g.bsdf, g.lights.empty() ? nullptr : g.lights.at(g.mesh ? prim : 0)};
 }
 
-// The surface at a hit Embree reported at distance t along `ray` (in the ray's own units).
-void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const {
+// fill_hit() for every other hit: instanced, on another shape, or with a tangent frame.
+void EmbreeScene::fill_hit_general(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const {
   // A hit inside an instance is computed in the prototype's space and then placed.
   const Instance* inst = hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[hit.instID[0]] : nullptr;
   const Geometry& g = inst ? prototypes_[inst->prototype].geometries[hit.geomID] : geometries_[hit.geomID];
@@ -451,13 +478,6 @@ void EmbreeScene::fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceIn
   si.bsdf = g.bsdf;
   si.media = g.media;
   if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? hit.primID : 0];
-  // The common case first: a triangle that is not instanced and needs no tangent frame, without the
-  // general case's locals (36 instructions per pixel sample on the Cornell box).
-  if (g.mesh && !inst && !g.tangent_frame) {
-    g.mesh->surface(hit.primID, Vec3(1.f - hit.u - hit.v, hit.u, hit.v), Vec3(hit.Ng_x, hit.Ng_y, hit.Ng_z), si);
-    si.shading = Frame(si.ns);
-    return;
-  }
   Ray local = inst ? Ray{Vec3(inst->to_object * Vec4(ray.o, 1.f)), glm::mat3(inst->to_object) * ray.d, ray.tmax} : ray;
   Vec3 dpdu(0.f), dpdv(0.f);  // for tangent frames and texture footprints only
   if (g.mesh) {

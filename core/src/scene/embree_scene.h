@@ -164,6 +164,7 @@ class EmbreeScene final : public Scene {
   void place_instanced_hit(SurfaceInteraction& si, const Instance& inst) const;
   RTCRayHit embree_ray(const Ray& ray, float* t_scale, float* t_shift) const;
   void fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const;
+  void fill_hit_general(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const;
   unsigned attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
                   const SurfaceOptions& options);
   /// The nearest hit on the spheres tested outside Embree with t in (0, *t_max): lowers *t_max to

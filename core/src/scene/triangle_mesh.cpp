@@ -1,6 +1,7 @@
 #include "scene/triangle_mesh.h"
 
 #include "scene/shape_sample_direction.h"
+#include "scene/triangle_surface.h"
 
 #include "util/cpu_clones.h"
 #include "util/triangle_warp.h"
@@ -55,32 +56,11 @@ Vec3 TriangleMesh::geometric_normal(size_t i, const Vec3& b) const {
   return oriented(face_normal(i), shading_normal(i, b));
 }
 
-// The hit's point, error bound, normals and uv straight into the record. The face normal is Embree's
-// for the hit (object space, so the prototype's for an instance): the same cross product of two edges
-// by the same winding, so the same sign, rounded differently in its last bits, and no read of
-// face_normals[i], a cache miss on a large mesh.
-PENUMBRA_X86_64_V3_CLONES void TriangleMesh::surface(size_t i, const Vec3& b_in, const Vec3& embree_ng,
+// Out of line (and cloned for x86-64-v3) for callers other than EmbreeScene's hit path, which
+// inlines fill_surface() itself.
+PENUMBRA_X86_64_V3_CLONES void TriangleMesh::surface(size_t i, const Vec3& b, const Vec3& embree_ng,
                                                      SurfaceInteraction& si) const {
-  const Vec3 b = b_in;  // a local: stores into `si` could otherwise alias it and force reloads
-  const Vec3 fn = glm::normalize(embree_ng);
-  const uint32_t* v = &indices[3 * i];
-  const Vec3 &p0 = P[v[0]], &p1 = P[v[1]], &p2 = P[v[2]];
-  si.p = b.x * p0 + b.y * p1 + b.z * p2;
-  si.p_error = error_gamma(7) * (abs_each(b.x * p0) + abs_each(b.y * p1) + abs_each(b.z * p2));
-  Vec3 ns(0.f);
-  if (!N.empty()) {
-    Vec3 n = b.x * N[v[0]] + b.y * N[v[1]] + b.z * N[v[2]];
-    float len2 = glm::dot(n, n);
-    if (len2 > 0.f) ns = n / std::sqrt(len2);
-  }
-  // oriented() written out: this x86-64-v3 clone called it out of line.
-  if (ns == Vec3(0.f)) {
-    si.ng = si.ns = flip_normal ? -fn : fn;
-  } else {
-    si.ng = glm::dot(fn, ns) < 0.f ? -fn : fn;
-    si.ns = ns;
-  }
-  si.uv = uv.empty() ? Vec2(b.y + b.z, b.z) : b.x * uv[v[0]] + b.y * uv[v[1]] + b.z * uv[v[2]];
+  fill_surface(i, b, embree_ng, si);
 }
 
 void TriangleMesh::uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const {
@@ -184,7 +164,8 @@ Triangle::Triangle(const TriangleMesh* mesh, uint32_t index) : mesh_(mesh), inde
     p_[k] = mesh->P[v[k]];
     uv_[k] = mesh->uv.empty() ? default_uv(k) : mesh->uv[v[k]];
   }
-  if (mesh->N.empty()) n_flat_ = mesh->geometric_normal(index, Vec3(1.f / 3.f));  // the same for every b
+  n_front_ = mesh->geometric_normal(index, Vec3(1.f / 3.f));
+  if (mesh->N.empty()) n_flat_ = n_front_;  // the same for every b
   centroid_ = (p_[0] + p_[1] + p_[2]) / 3.f;
   area_ = mesh->area(index);
   inv_area_ = 1.f / area_;
@@ -195,9 +176,14 @@ Triangle::Triangle(const TriangleMesh* mesh, uint32_t index) : mesh_(mesh), inde
 // every triangle sphericaly cost 11.5 % more instructions per ray for the same variance.
 constexpr float kSphericalAboveApproxSolidAngle = 0.25f;
 
+// And only where the point is in front of the triangle (the side its oriented normal faces): a
+// one-sided emitter, the usual area light, sends nothing behind it, so spherical samples there would
+// all carry zero. On the Cornell box every spherical sample was such a one (ceiling points within
+// 0.6 of the light, which faces down): 4 % of the path tracer's time (docs/benchmarks.md, "Spherical
+// light samples only in front"). A two-sided emitter is sampled by area from behind.
 bool Triangle::spherical_worthwhile(const Vec3& p) const {
   Vec3 d = centroid_ - p;
-  return area_ >= kSphericalAboveApproxSolidAngle * glm::dot(d, d);
+  return area_ >= kSphericalAboveApproxSolidAngle * glm::dot(d, d) && glm::dot(d, n_front_) < 0.f;
 }
 
 // Uniform in the solid angle the triangle subtends (Arvo's spherical triangle sampling) where the

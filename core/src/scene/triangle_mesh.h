@@ -35,6 +35,10 @@ struct TriangleMesh {
   /// shading normals, uv), written into si; embree_ng is the unnormalised normal Embree reports for
   /// the hit (RTCHit::Ng).
   void surface(size_t i, const Vec3& b, const Vec3& embree_ng, SurfaceInteraction& si) const;
+  /// surface(), always inlined (scene/triangle_surface.h): for the scene's hit path, so that the
+  /// record's stores meet their initialisation in one function.
+  [[gnu::always_inline]] inline void fill_surface(size_t i, const Vec3& b, const Vec3& embree_ng,
+                                                  SurfaceInteraction& si) const;
   /// dp/du and dp/dv of triangle i (constant over it); for a degenerate uv mapping, two axes
   /// perpendicular to the face normal.
   void uv_derivatives(size_t i, Vec3* dpdu, Vec3* dpdv) const;
@@ -71,6 +75,7 @@ class Triangle final : public Shape {
   Vec3 p_[3];
   Vec2 uv_[3];         // the mesh's, or pbrt's default (default_uv() in the .cpp)
   Vec3 n_flat_{0.f};   // the oriented face normal, for a mesh without shading normals (else zero)
+  Vec3 n_front_;       // the face normal oriented as at the centroid: the side spherical sampling serves
   Vec3 centroid_;
   float area_, inv_area_;
 };
