@@ -118,10 +118,6 @@ ChiSquareResult triangle_chi_square(const TriangleMesh& mesh, double z_min) {
   return r;
 }
 
-}  // namespace
-
-namespace {
-
 // Whether the triangle's density seen from the origin is the same towards its centroid and towards a
 // point near its first vertex: uniform in solid angle (spherical sampling) or not (by area).
 bool uniform_in_solid_angle(const TriangleMesh& mesh) {

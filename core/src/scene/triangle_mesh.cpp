@@ -179,8 +179,8 @@ constexpr float kSphericalAboveApproxSolidAngle = 0.25f;
 // And only where the point is in front of the triangle (the side its oriented normal faces): a
 // one-sided emitter, the usual area light, sends nothing behind it, so spherical samples there would
 // all carry zero. On the Cornell box every spherical sample was such a one (ceiling points within
-// 0.6 of the light, which faces down): 4 % of the path tracer's time (docs/benchmarks.md, "Spherical
-// light samples only in front"). A two-sided emitter is sampled by area from behind.
+// 0.6 of the light, which faces down): 1.7-1.9 % of the path tracer's time (docs/benchmarks.md,
+// "What bounds the path tracer"). A two-sided emitter is sampled by area from behind.
 bool Triangle::spherical_worthwhile(const Vec3& p) const {
   Vec3 d = centroid_ - p;
   return area_ >= kSphericalAboveApproxSolidAngle * glm::dot(d, d) && glm::dot(d, n_front_) < 0.f;

@@ -35,8 +35,8 @@ struct TriangleMesh {
   /// shading normals, uv), written into si; embree_ng is the unnormalised normal Embree reports for
   /// the hit (RTCHit::Ng).
   void surface(size_t i, const Vec3& b, const Vec3& embree_ng, SurfaceInteraction& si) const;
-  /// surface(), always inlined (scene/triangle_surface.h): for the scene's hit path, so that the
-  /// record's stores meet their initialisation in one function.
+  /// surface(), always inlined (scene/triangle_surface.h): for the scene's hit path, which then
+  /// calls nothing for a triangle hit.
   [[gnu::always_inline]] inline void fill_surface(size_t i, const Vec3& b, const Vec3& embree_ng,
                                                   SurfaceInteraction& si) const;
   /// dp/du and dp/dv of triangle i (constant over it); for a degenerate uv mapping, two axes

@@ -27,7 +27,7 @@ inline void TriangleMesh::fill_surface(size_t i, const Vec3& b_in, const Vec3& e
     float len2 = glm::dot(n, n);
     if (len2 > 0.f) ns = n / std::sqrt(len2);
   }
-  // oriented() written out: in an x86-64-v3 clone it was called out of line.
+  // oriented() written out: an x86-64-v3 clone of the caller called it out of line.
   if (ns == Vec3(0.f)) {
     si.ng = si.ns = flip_normal ? -fn : fn;
   } else {
