@@ -194,3 +194,36 @@ TEST(ShapeSampleFields, CheckRejectsMissingOrWrongFields) {
   far.distance *= 1.01f;
   EXPECT_FALSE(direction_fields_match(far, ref));
 }
+
+// A caller that can use only the front (a one-sided emitter: ShapeSampleContext::front_only) gets
+// nothing from behind a flat triangle, with density 0 there, and from the front exactly the samples
+// and densities it gets without asking.
+TEST(TriangleSampling, FrontOnlyContextGetsNothingFromBehindAndTheSameFromTheFront) {
+  TriangleMesh mesh;
+  mesh.P = {Vec3(-1, -0.5f, 1), Vec3(1.5f, -0.3f, 1.2f), Vec3(0.2f, 1.4f, 0.8f)};
+  for (bool facing_origin : {false, true}) {
+    mesh.indices = facing_origin ? std::vector<uint32_t>{0, 2, 1} : std::vector<uint32_t>{0, 1, 2};
+    Triangle tri(&mesh, 0);
+    const ShapeSampleContext any{Vec3(0.f), Vec3(0.f)}, front{Vec3(0.f), Vec3(0.f), true};
+    const Vec3 n = mesh.geometric_normal(0, Vec3(1 / 3.f));
+    int sampled = 0;
+    for (int i = 0; i < 256; ++i) {
+      Vec2 u((i + 0.5f) / 256.f, std::fmod(i * 0.618034f, 1.f));
+      std::optional<ShapeSample> a = tri.sample_solid_angle(any, u), f = tri.sample_solid_angle(front, u);
+      ASSERT_TRUE(a.has_value());
+      const float pdf_any = tri.pdf_solid_angle(any, a->wi, a->p, n), pdf_front = tri.pdf_solid_angle(front, a->wi, a->p, n);
+      if (!facing_origin) {
+        EXPECT_FALSE(f.has_value()) << "a sample from behind for a caller that wants the front only";
+        EXPECT_EQ(pdf_front, 0.f);
+        EXPECT_GT(pdf_any, 0.f);
+        continue;
+      }
+      ASSERT_TRUE(f.has_value());
+      EXPECT_EQ(f->p, a->p);
+      EXPECT_EQ(f->pdf, a->pdf);
+      EXPECT_EQ(pdf_front, pdf_any);
+      ++sampled;
+    }
+    EXPECT_EQ(sampled, facing_origin ? 256 : 0);
+  }
+}

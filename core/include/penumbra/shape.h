@@ -27,6 +27,10 @@ struct ShapeSample {
 struct ShapeSampleContext {
   Vec3 p;
   Vec3 n{0.f};  // zero when the point is not on a surface
+  /// Set by a caller that can use only points whose front (the side the shape's oriented normal
+  /// faces) p sees, such as a one-sided emitter. A shape may then sample nothing, and give density 0,
+  /// where p is behind all of it (a flat shape's back); shapes that ignore it stay correct.
+  bool front_only = false;
 };
 
 class Shape {

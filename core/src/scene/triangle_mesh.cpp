@@ -190,8 +190,17 @@ bool Triangle::spherical_worthwhile(const Vec3& p) const {
 // triangle is near and large and that is numerically safe, otherwise uniform in area;
 // pdf_solid_angle() makes the same choice.
 std::optional<ShapeSample> Triangle::sample_solid_angle(const ShapeSampleContext& ctx, Vec2 u) const {
+  if (unseen_front(ctx)) return std::nullopt;
   if (spherical_worthwhile(ctx.p)) return sample_spherical(ctx, u);
   return sample_by_area(ctx, u);
+}
+
+// A flat triangle (no shading normals: one oriented normal everywhere) with the caller asking for its
+// front only, seen from behind or edge-on: every sample would carry nothing. 17 % of the Cornell box's
+// light samples are such ones, from the ceiling behind the light (docs/benchmarks.md, "What bounds the
+// path tracer").
+bool Triangle::unseen_front(const ShapeSampleContext& ctx) const {
+  return ctx.front_only && n_flat_ != Vec3(0.f) && glm::dot(centroid_ - ctx.p, n_flat_) >= 0.f;
 }
 
 // Out of line: inlined, its loads of the vertices and its stack frame were paid by the area samples
@@ -241,6 +250,7 @@ PENUMBRA_X86_64_V3_CLONES bool Triangle::sample_area_seen_from(const Vec3& ref, 
 
 float Triangle::pdf_solid_angle(const ShapeSampleContext& ctx, const Vec3& wi, const Vec3& p_hit,
                                 const Vec3& n_hit) const {
+  if (unseen_front(ctx)) return 0.f;
   if (!spherical_worthwhile(ctx.p)) {
     float pdf = area_to_solid_angle_pdf(inv_area_, ctx.p, p_hit, n_hit);
     return std::isinf(pdf) ? 0.f : pdf;

@@ -59,6 +59,8 @@ class Triangle final : public Shape {
 
  private:
   bool spherical_worthwhile(const Vec3& p) const;
+  /// ctx asks for the front only and cannot see it: nothing to sample (density 0).
+  bool unseen_front(const ShapeSampleContext& ctx) const;
   /// sample_solid_angle() where spherical_worthwhile(): by solid angle where that is numerically safe.
   std::optional<ShapeSample> sample_spherical(const ShapeSampleContext& ctx, Vec2 u) const;
   std::optional<ShapeSample> sample_by_area(const ShapeSampleContext& ctx, Vec2 u) const;

@@ -28,7 +28,8 @@ class DiffuseAreaLight final : public Light {
 
   std::optional<LightLiSample> sample_li(const LightSampleContext& ctx, Vec2 u) const override {
     std::optional<LightLiSample> ls;  // returned by name on every path (emplace_li_sample())
-    std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, u);
+    // One-sided: a point behind a flat shape gets nothing from it, and the shape may skip sampling.
+    std::optional<ShapeSample> ss = shape_->sample_solid_angle(ShapeSampleContext{ctx.p, ctx.n, !twosided_}, u);
     if (!ss || !(ss->pdf > 0.f) || !shape_->present(*ss)) return ls;
     if (ss->distance == 0.f) return ls;
     const Vec3& wi = ss->wi;  // the shape's, computed for the density
@@ -39,7 +40,7 @@ class DiffuseAreaLight final : public Light {
   }
 
   float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const SurfaceInteraction& hit) const override {
-    return shape_->pdf_solid_angle(ShapeSampleContext{ctx.p, ctx.n}, wi, hit.p, hit.ng);
+    return shape_->pdf_solid_angle(ShapeSampleContext{ctx.p, ctx.n, !twosided_}, wi, hit.p, hit.ng);
   }
 
   // Emitted rays: a point uniform in area, a cosine-distributed direction on the emitting side (a
