@@ -15,6 +15,20 @@ static void embree_error(void*, RTCError code, const char* message) {
   throw Error(fmt::format("Embree error {}: {}", static_cast<int>(code), message ? message : ""));
 }
 
+// What every hit records besides its surface: distance, direction back, ids, material, media and
+// the primitive's emitter (one per triangle of a mesh, one for other shapes).
+[[gnu::always_inline]] inline void EmbreeScene::fill_hit_record(const Ray& ray, float t, const Geometry& g,
+                                                                unsigned shape_id, unsigned prim_id,
+                                                                SurfaceInteraction& si) {
+  si.t = t;
+  si.wo = -glm::normalize(ray.d);
+  si.shape_id = shape_id;
+  si.prim_id = prim_id;
+  si.bsdf = g.bsdf;
+  si.media = g.media;
+  if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? prim_id : 0];
+}
+
 // The surface at a hit Embree reported at distance t along `ray` (in the ray's own units). The
 // common case, a triangle that is not instanced and needs no tangent frame, is inlined into the
 // functions that trace (intersect(), intersect_coherent()) with the triangle's surface, so it makes
@@ -25,13 +39,7 @@ static void embree_error(void*, RTCError code, const char* message) {
   if (hit.instID[0] == RTC_INVALID_GEOMETRY_ID) {
     const Geometry& g = geometries_[hit.geomID];
     if (g.mesh && !g.tangent_frame) {
-      si.t = t;
-      si.wo = -glm::normalize(ray.d);
-      si.shape_id = hit.geomID;
-      si.prim_id = hit.primID;
-      si.bsdf = g.bsdf;
-      si.media = g.media;
-      if (!g.lights.empty()) si.area_light = g.lights[hit.primID];
+      fill_hit_record(ray, t, g, hit.geomID, hit.primID, si);
       g.mesh->fill_surface(hit.primID, Vec3(1.f - hit.u - hit.v, hit.u, hit.v), Vec3(hit.Ng_x, hit.Ng_y, hit.Ng_z), si);
       si.shading = Frame(si.ns);
       return;
@@ -470,13 +478,7 @@ void EmbreeScene::fill_hit_general(const Ray& ray, float t, const RTCHit& hit, S
   // A hit inside an instance is computed in the prototype's space and then placed.
   const Instance* inst = hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? &instances_[hit.instID[0]] : nullptr;
   const Geometry& g = inst ? prototypes_[inst->prototype].geometries[hit.geomID] : geometries_[hit.geomID];
-  si.t = t;
-  si.wo = -glm::normalize(ray.d);
-  si.shape_id = inst ? hit.instID[0] : hit.geomID;
-  si.prim_id = hit.primID;
-  si.bsdf = g.bsdf;
-  si.media = g.media;
-  if (!g.lights.empty()) si.area_light = g.lights[g.mesh ? hit.primID : 0];
+  fill_hit_record(ray, t, g, inst ? hit.instID[0] : hit.geomID, hit.primID, si);
   Ray local = inst ? Ray{Vec3(inst->to_object * Vec4(ray.o, 1.f)), glm::mat3(inst->to_object) * ray.d, ray.tmax} : ray;
   Vec3 dpdu(0.f), dpdv(0.f);  // for tangent frames and texture footprints only
   if (g.mesh) {

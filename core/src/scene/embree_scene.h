@@ -165,6 +165,8 @@ class EmbreeScene final : public Scene {
   RTCRayHit embree_ray(const Ray& ray, float* t_scale, float* t_shift) const;
   void fill_hit(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const;
   void fill_hit_general(const Ray& ray, float t, const RTCHit& hit, SurfaceInteraction& si) const;
+  static void fill_hit_record(const Ray& ray, float t, const Geometry& g, unsigned shape_id, unsigned prim_id,
+                              SurfaceInteraction& si);
   unsigned attach(RTCGeometry geom, Geometry g, const Bsdf* bsdf, bool textured, MediumInterface media,
                   const SurfaceOptions& options);
   /// The nearest hit on the spheres tested outside Embree with t in (0, *t_max): lowers *t_max to
