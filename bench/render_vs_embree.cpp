@@ -9,7 +9,7 @@
 //   --raw-only        skips the path-tracer render: only raw Embree on the scene's geometry (any scene file;
 //                     spheres the scene tests outside Embree, up to four, are not in Embree's scene)
 //   --camera-packets  only the scene's camera rays at its film resolution (about --rays of them), one
-//                     at a time and as 8-wide packets
+//                     at a time and as 8-wide and 16-wide packets
 //   --minimal         each round also renders with bench/minimal_path_tracer.h, the same estimator written
 //                     straight on Embree (Lambertian triangles and area lights only), and reports its ray
 //                     rate and ratio to raw Embree: what the renderer's ratio could be without its overheads;
@@ -41,6 +41,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 using namespace penumbra;
@@ -124,19 +125,56 @@ RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
   return {n / t_closest * 1e-6, n / t_shadow * 1e-6, 2.0 * n / (t_closest + t_shadow) * 1e-6};
 }
 
-// The scene's camera rays through every pixel centre, traced one at a time (rtcIntersect1) and as
-// 8-wide packets of 4x2 pixels (rtcIntersect8, coherent): what packet tracing of camera rays would
-// gain, which the renderer does not do (docs/benchmarks.md, "Camera rays as packets"). Both return
-// the same hits except along edges between primitives, where the two intersectors round differently
-// (counted; more than 0.1 % of the pixels is an error). Mrays/s on `threads` threads; both ways fill
-// their query structures inside the timing, as a renderer would for each ray.
+// The scene's camera rays through every pixel centre, traced one at a time (rtcIntersect1), as
+// 8-wide packets of 4x2 pixels (rtcIntersect8, coherent) and as 16-wide packets of 4x4 pixels
+// (rtcIntersect16): what the render loop's packets of camera rays gain (docs/benchmarks.md, "Camera
+// rays as packets"). All return the same hits except along edges between primitives, where the
+// intersectors round differently (counted against the single rays; more than 0.1 % of the pixels is
+// an error). Mrays/s on `threads` threads; every way fills its query structures inside the timing,
+// as a renderer would for each ray.
 struct CameraRays {
-  double single_mrays, packet_mrays;
-  size_t differ;  // pixels whose two rays hit different geometry
+  double single_mrays, packet8_mrays, packet16_mrays;
+  size_t differ8, differ16;  // pixels whose packet ray hit other geometry than the single ray
 };
 
+// Seconds to trace `rays` (w x h, row-major) `repeats` times as packets of kWidth lanes covering 4 x
+// (kWidth / 4) pixels; each ray's geometry id goes to `hit`.
+template <int kWidth>
+double trace_packets(RTCScene scene, const std::vector<Ray>& rays, int w, int h, int repeats,
+                     std::vector<unsigned>& hit) {
+  using Packet = std::conditional_t<kWidth == 16, RTCRayHit16, RTCRayHit8>;
+  constexpr int rows = kWidth / 4;
+  double t0 = now();
+  for (int rep = 0; rep < repeats; ++rep)
+    tbb::parallel_for(tbb::blocked_range<int>(0, h / rows), [&](const tbb::blocked_range<int>& r) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      alignas(64) int valid[kWidth];
+      alignas(64) Packet p;
+      for (int py = r.begin(); py < r.end(); ++py)
+        for (int x0 = 0; x0 < w; x0 += 4) {
+          std::memset(&p, 0, sizeof p);
+          for (int k = 0; k < kWidth; ++k) {
+            const Ray& ray = rays[static_cast<size_t>(rows * py + k / 4) * w + x0 + k % 4];
+            valid[k] = -1;
+            p.ray.org_x[k] = ray.o.x, p.ray.org_y[k] = ray.o.y, p.ray.org_z[k] = ray.o.z;
+            p.ray.dir_x[k] = ray.d.x, p.ray.dir_y[k] = ray.d.y, p.ray.dir_z[k] = ray.d.z;
+            p.ray.tfar[k] = Infinity;
+            p.ray.mask[k] = 0xFFFFFFFFu;
+            p.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+          }
+          if constexpr (kWidth == 16) rtcIntersect16(valid, scene, &ctx, &p);
+          else rtcIntersect8(valid, scene, &ctx, &p);
+          for (int k = 0; k < kWidth; ++k)
+            hit[static_cast<size_t>(rows * py + k / 4) * w + x0 + k % 4] = p.hit.geomID[k];
+        }
+    });
+  return now() - t0;
+}
+
 CameraRays camera_rays(RTCScene scene, const Camera& camera, Point2i res, int threads, int repeats) {
-  const int w = (res.x + 3) / 4 * 4, h = (res.y + 1) / 2 * 2;  // whole packets; extra pixels repeat
+  const int w = (res.x + 3) / 4 * 4, h = (res.y + 3) / 4 * 4;  // whole packets; extra pixels repeat
   std::vector<Ray> rays(static_cast<size_t>(w) * h);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -145,7 +183,7 @@ CameraRays camera_rays(RTCScene scene, const Camera& camera, Point2i res, int th
       rays[static_cast<size_t>(y) * w + x] = r ? *r : Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f), Infinity};
     }
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  std::vector<unsigned> single_hit(rays.size()), packet_hit(rays.size());
+  std::vector<unsigned> single_hit(rays.size()), hit8(rays.size()), hit16(rays.size());
   double t0 = now();
   for (int rep = 0; rep < repeats; ++rep)
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
@@ -160,40 +198,20 @@ CameraRays camera_rays(RTCScene scene, const Camera& camera, Point2i res, int th
         }
     });
   double t_single = now() - t0;
-  t0 = now();
-  for (int rep = 0; rep < repeats; ++rep)
-    tbb::parallel_for(tbb::blocked_range<int>(0, h / 2), [&](const tbb::blocked_range<int>& r) {
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-      alignas(32) int valid[8];
-      alignas(32) RTCRayHit8 p;
-      for (int py = r.begin(); py < r.end(); ++py)
-        for (int x0 = 0; x0 < w; x0 += 4) {
-          std::memset(&p, 0, sizeof p);
-          for (int k = 0; k < 8; ++k) {
-            const Ray& ray = rays[static_cast<size_t>(2 * py + k / 4) * w + x0 + k % 4];
-            valid[k] = -1;
-            p.ray.org_x[k] = ray.o.x, p.ray.org_y[k] = ray.o.y, p.ray.org_z[k] = ray.o.z;
-            p.ray.dir_x[k] = ray.d.x, p.ray.dir_y[k] = ray.d.y, p.ray.dir_z[k] = ray.d.z;
-            p.ray.tfar[k] = Infinity;
-            p.ray.mask[k] = 0xFFFFFFFFu;
-            p.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-          }
-          rtcIntersect8(valid, scene, &ctx, &p);
-          for (int k = 0; k < 8; ++k)
-            packet_hit[static_cast<size_t>(2 * py + k / 4) * w + x0 + k % 4] = p.hit.geomID[k];
-        }
-    });
-  double t_packet = now() - t0;
-  size_t differ = 0;
-  for (size_t i = 0; i < rays.size(); ++i) differ += single_hit[i] != packet_hit[i];
-  if (differ * 1000 > rays.size())
-    throw Error(fmt::format("camera rays: packets and single rays hit different geometry at {} of {} pixels "
-                            "(spheres, disks and cylinders are user geometry that answers single rays only)",
-                            differ, rays.size()));
+  double t8 = trace_packets<8>(scene, rays, w, h, repeats, hit8);
+  double t16 = trace_packets<16>(scene, rays, w, h, repeats, hit16);
+  size_t differ8 = 0, differ16 = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    differ8 += single_hit[i] != hit8[i];
+    differ16 += single_hit[i] != hit16[i];
+  }
+  if (std::max(differ8, differ16) * 1000 > rays.size())
+    throw Error(fmt::format("camera rays: packets and single rays hit different geometry at {} (8-wide) and {} "
+                            "(16-wide) of {} pixels (spheres, disks and cylinders are user geometry that answers "
+                            "single rays only)",
+                            differ8, differ16, rays.size()));
   double n = static_cast<double>(rays.size()) * repeats;
-  return {n / t_single * 1e-6, n / t_packet * 1e-6, differ};
+  return {n / t_single * 1e-6, n / t8 * 1e-6, n / t16 * 1e-6, differ8, differ16};
 }
 
 }  // namespace
@@ -216,7 +234,7 @@ int main(int argc, char** argv) {
   app.add_option("--rounds", rounds, "alternated rounds of render and raw Embree (default 5)")
       ->check(cli::whole_number(1, 1000, "a whole number of rounds from 1 to 1000"));
   app.add_flag("--raw-only", raw_only, "only raw Embree on the scene's geometry");
-  app.add_flag("--camera-packets", camera_packets, "only the camera rays, one at a time and as 8-wide packets");
+  app.add_flag("--camera-packets", camera_packets, "only the camera rays, one at a time and as 8- and 16-wide packets");
   app.add_flag("--minimal", minimal, "also the minimal path tracer on raw Embree, in every round");
   app.add_flag("--json", json, "one JSON object per thread count instead of the table");
   if (std::optional<int> exit_code = cli::parse_tool_options(app, argc, argv, "penumbra-bench-render:"))
@@ -244,9 +262,12 @@ int main(int argc, char** argv) {
       for (int threads : thread_counts) {
         CameraRays c = camera_rays(built.scene->rtc_scene(), built.scene->camera(), film_res, threads, repeats);
         fmt::print("scene {}: {} triangles, {}x{} camera rays, {} threads: one at a time {:.2f}, 8-wide packets "
-                   "{:.2f} Mrays/s ({:.2f}x; {} pixels hit other geometry)\n",
+                   "{:.2f} ({:.2f}x; {} pixels hit other geometry), 16-wide packets {:.2f} Mrays/s ({:.2f}x; {}); "
+                   "Embree's native 16-wide packets: {}\n",
                    scene_file, built.scene->triangle_count(), film_res.x, film_res.y, threads, c.single_mrays,
-                   c.packet_mrays, c.packet_mrays / c.single_mrays, c.differ);
+                   c.packet8_mrays, c.packet8_mrays / c.single_mrays, c.differ8, c.packet16_mrays,
+                   c.packet16_mrays / c.single_mrays, c.differ16,
+                   built.scene->packet_width() == 16 ? "yes" : "no (emulated)");
       }
       return 0;
     }

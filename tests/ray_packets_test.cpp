@@ -1,6 +1,7 @@
 // EmbreeScene::intersect_coherent(), the packets of camera rays the render loop traces for pixel
 // integrators, answers every ray as intersect() does: triangles, spheres (user geometry, answered
-// lane by lane), instances and empty lanes, with the rays counted once each.
+// lane by lane), instances and empty lanes, with the rays counted once each, in packets of up to 8
+// and up to 16 lanes.
 #include "render/ray_counter.h"
 #include "scene/embree_scene.h"
 
@@ -49,8 +50,9 @@ TEST(RayPackets, EveryLaneAnswersAsASingleRay) {
   Pcg32 rng(11, 12);
   int seen[4] = {0, 0, 0, 0};
   for (int packet = 0; packet < 4000; ++packet) {
-    // Packets of 1 to 8 rays around a common direction, with empty lanes among them.
-    int n = 1 + packet % 8;
+    // Packets of 1 to 16 rays around a common direction (8-wide packets up to 8, 16-wide above),
+    // with empty lanes among them.
+    int n = 1 + packet % 16;
     Vec3 centre(1.2f * (rng.next_float() - 0.5f) * 4.f, 1.2f * (rng.next_float() - 0.5f) * 4.f, 5.f);
     std::vector<std::optional<Ray>> rays(n);
     std::vector<const Ray*> ptrs(n, nullptr);
@@ -60,7 +62,7 @@ TEST(RayPackets, EveryLaneAnswersAsASingleRay) {
       rays[k] = Ray{Vec3(0.f), glm::normalize(target), Infinity};
       ptrs[k] = &*rays[k];
     }
-    std::optional<SurfaceInteraction> hits[8];
+    std::optional<SurfaceInteraction> hits[16];
     for (auto& h : hits) h.emplace();  // stale values must be cleared
     scene.intersect_coherent(std::span<const Ray* const>(ptrs), hits);
     for (int k = 0; k < n; ++k) {
@@ -80,6 +82,17 @@ TEST(RayPackets, EveryLaneAnswersAsASingleRay) {
   }
   // Every kind of answer was exercised.
   for (int i = 0; i < 4; ++i) EXPECT_GT(seen[i], 500) << "kind " << i;
+}
+
+// The render loop's blocks follow the packet width: 16 where Embree traces 16-wide packets natively.
+TEST(RayPackets, WidthIsWhatEmbreeTracesNatively) {
+  EmbreeScene scene;
+  build(scene);
+  RTCDevice device = rtcNewDevice(nullptr);
+  ASSERT_NE(device, nullptr);
+  bool native16 = rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+  rtcReleaseDevice(device);
+  EXPECT_EQ(scene.packet_width(), native16 ? 16 : 8);
 }
 
 TEST(RayPackets, CountsEachRayOnce) {

@@ -4,7 +4,8 @@
 // bit whatever the thread count, and a part of a split render (indices [first_sample, first_sample +
 // spp)) takes exactly its share of them. Splats go to the film's per-thread fixed-point buffers,
 // whose integer sums do not depend on the order of the additions. Pixel integrators that take their
-// camera ray's first hit are walked in 4x2-pixel blocks whose camera rays are traced as one packet.
+// camera ray's first hit are walked in blocks of 4x4 pixels (4x2 where Embree has no native 16-wide
+// packets) whose camera rays are traced as one packet.
 #include "image/splat_buffers.h"
 #include "render/checkpoint.h"
 #include "render/surface_sample.h"
@@ -54,10 +55,12 @@ class CheckedSplats final : public SplatSink {
 };
 
 // Pixel integrators whose Li() starts by tracing the camera ray get it traced by the loop, as one
-// Embree packet per block of 4x2 pixels at one sample index (EmbreeScene::intersect_coherent()).
-// The block is a fixed set of pixels (tiles are 16x16 and start at multiples of 16), so a pixel's
-// packet does not depend on passes, threads or split renders.
-constexpr int kBlockWidth = 4, kBlockHeight = 2, kMaxLanes = kBlockWidth * kBlockHeight;
+// Embree packet per block of pixels at one sample index (EmbreeScene::intersect_coherent()): 4x4
+// pixels where Embree traces 16-wide packets natively (AVX-512), 4x2 otherwise. 16-wide packets
+// took 2 % off the path tracer's time on the Cornell box and 3 % on cornell-water at 256x256 against
+// 8-wide ones (docs/benchmarks.md). The block is a fixed set of pixels (tiles are 16x16 and start at
+// multiples of 16), so a pixel's packet does not depend on passes, threads or split renders.
+constexpr int kBlockWidth = 4, kMaxLanes = 16;
 
 struct ThreadState {
   std::vector<std::unique_ptr<Sampler>> samplers;  // one per pixel of a block
@@ -147,7 +150,7 @@ void SampleIntegrator::render(RenderContext& ctx) {
   const auto* pixel_integrator = dynamic_cast<const PixelIntegrator*>(this);
   const EmbreeScene* packets = pixel_integrator && pixel_integrator->takes_first_hit()
                                    ? dynamic_cast<const EmbreeScene*>(&scene) : nullptr;
-  const int block_w = packets ? kBlockWidth : 1, block_h = packets ? kBlockHeight : 1;
+  const int block_w = packets ? kBlockWidth : 1, block_h = packets ? packets->packet_width() / kBlockWidth : 1;
   tbb::enumerable_thread_specific<ThreadState> threads([&] {
     ThreadState ts{{}, CheckedSplats(ctx, film)};
     for (int k = 0; k < block_w * block_h; ++k) ts.samplers.push_back(ctx.sampler().clone());

@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include <bit>
+#include <type_traits>
 
 namespace penumbra {
 
@@ -54,6 +55,7 @@ EmbreeScene::EmbreeScene() {
   rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+  native_packet16_ = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
 }
 
 EmbreeScene::~EmbreeScene() {
@@ -422,47 +424,55 @@ std::optional<SurfaceInteraction> EmbreeScene::intersect(const Ray& ray) const {
 }
 
 void EmbreeScene::intersect_coherent(std::span<const Ray* const> rays, std::optional<SurfaceInteraction>* hits) const {
-  if (has_curves_ || rays.size() > 8) {  // curves move each ray's origin (embree_ray()): one at a time
+  if (has_curves_ || rays.size() > 16) {  // curves move each ray's origin (embree_ray()): one at a time
     for (size_t i = 0; i < rays.size(); ++i) {
       if (rays[i]) hits[i] = intersect(*rays[i]);
       else hits[i].reset();
     }
     return;
   }
+  if (rays.size() > 8) intersect_packet<16>(rays, hits);
+  else intersect_packet<8>(rays, hits);
+}
+
+template <int kWidth>
+void EmbreeScene::intersect_packet(std::span<const Ray* const> rays, std::optional<SurfaceInteraction>* hits) const {
+  using Packet = std::conditional_t<kWidth == 16, RTCRayHit16, RTCRayHit8>;
   // Each lane is the ray intersect() would trace (embree_query()); empty lanes are masked off.
-  alignas(32) int valid[8];
-  alignas(32) RTCRayHit8 packet;
-  unsigned spheres[8];
-  RTCRayN* lanes = RTCRayHitN_RayN(reinterpret_cast<RTCRayHitN*>(&packet), 8);
-  RTCHitN* lane_hits = RTCRayHitN_HitN(reinterpret_cast<RTCRayHitN*>(&packet), 8);
-  for (unsigned i = 0; i < 8; ++i) {
+  alignas(64) int valid[kWidth];
+  alignas(64) Packet packet;
+  unsigned spheres[kWidth];
+  RTCRayN* lanes = RTCRayHitN_RayN(reinterpret_cast<RTCRayHitN*>(&packet), kWidth);
+  RTCHitN* lane_hits = RTCRayHitN_HitN(reinterpret_cast<RTCRayHitN*>(&packet), kWidth);
+  for (unsigned i = 0; i < kWidth; ++i) {
     const Ray* r = i < rays.size() ? rays[i] : nullptr;
     valid[i] = r ? -1 : 0;
     RTCRayHit one = embree_query(r ? *r : Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f), -Infinity});
     spheres[i] = r && !direct_spheres_.empty() ? nearest_direct_sphere(*r, &one.ray.tfar) : RTC_INVALID_GEOMETRY_ID;
-    RTCRayN_org_x(lanes, 8, i) = one.ray.org_x, RTCRayN_org_y(lanes, 8, i) = one.ray.org_y;
-    RTCRayN_org_z(lanes, 8, i) = one.ray.org_z, RTCRayN_tnear(lanes, 8, i) = one.ray.tnear;
-    RTCRayN_dir_x(lanes, 8, i) = one.ray.dir_x, RTCRayN_dir_y(lanes, 8, i) = one.ray.dir_y;
-    RTCRayN_dir_z(lanes, 8, i) = one.ray.dir_z, RTCRayN_time(lanes, 8, i) = one.ray.time;
-    RTCRayN_tfar(lanes, 8, i) = one.ray.tfar, RTCRayN_mask(lanes, 8, i) = one.ray.mask;
-    RTCRayN_id(lanes, 8, i) = one.ray.id, RTCRayN_flags(lanes, 8, i) = one.ray.flags;
-    RTCHitN_geomID(lane_hits, 8, i) = one.hit.geomID;
-    RTCHitN_instID(lane_hits, 8, i, 0) = one.hit.instID[0];
+    RTCRayN_org_x(lanes, kWidth, i) = one.ray.org_x, RTCRayN_org_y(lanes, kWidth, i) = one.ray.org_y;
+    RTCRayN_org_z(lanes, kWidth, i) = one.ray.org_z, RTCRayN_tnear(lanes, kWidth, i) = one.ray.tnear;
+    RTCRayN_dir_x(lanes, kWidth, i) = one.ray.dir_x, RTCRayN_dir_y(lanes, kWidth, i) = one.ray.dir_y;
+    RTCRayN_dir_z(lanes, kWidth, i) = one.ray.dir_z, RTCRayN_time(lanes, kWidth, i) = one.ray.time;
+    RTCRayN_tfar(lanes, kWidth, i) = one.ray.tfar, RTCRayN_mask(lanes, kWidth, i) = one.ray.mask;
+    RTCRayN_id(lanes, kWidth, i) = one.ray.id, RTCRayN_flags(lanes, kWidth, i) = one.ray.flags;
+    RTCHitN_geomID(lane_hits, kWidth, i) = one.hit.geomID;
+    RTCHitN_instID(lane_hits, kWidth, i, 0) = one.hit.instID[0];
   }
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  rtcIntersect8(valid, scene_, &ctx, &packet);
+  if constexpr (kWidth == 16) rtcIntersect16(valid, scene_, &ctx, &packet);
+  else rtcIntersect8(valid, scene_, &ctx, &packet);
   for (size_t i = 0; i < rays.size(); ++i) {
     hits[i].reset();
     if (!rays[i]) continue;
     count_ray();
-    if (RTCHitN_geomID(lane_hits, 8, i) == RTC_INVALID_GEOMETRY_ID) {
+    if (RTCHitN_geomID(lane_hits, kWidth, i) == RTC_INVALID_GEOMETRY_ID) {
       if (spheres[i] != RTC_INVALID_GEOMETRY_ID)
-        fill_direct_sphere_hit(*rays[i], RTCRayN_tfar(lanes, 8, i), spheres[i], hits[i].emplace());
+        fill_direct_sphere_hit(*rays[i], RTCRayN_tfar(lanes, kWidth, i), spheres[i], hits[i].emplace());
       continue;
     }
-    fill_hit(*rays[i], RTCRayN_tfar(lanes, 8, i), rtcGetHitFromHitN(lane_hits, 8, i), hits[i].emplace());
+    fill_hit(*rays[i], RTCRayN_tfar(lanes, kWidth, i), rtcGetHitFromHitN(lane_hits, kWidth, i), hits[i].emplace());
   }
 }
 
