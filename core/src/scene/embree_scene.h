@@ -109,8 +109,8 @@ class EmbreeScene final : public Scene {
   /// fixed set of rays (a pixel block at one sample index), because where two triangles share an
   /// edge, which one a ray reports can depend on the other rays of its packet.
   void intersect_coherent(std::span<const Ray* const> rays, std::optional<SurfaceInteraction>* hits) const;
-  /// The widest packet this machine's Embree traces natively: 16 with AVX-512, else 8 (wider
-  /// packets are emulated, slower than two narrower ones).
+  /// The packet width the render loop should use: 16 where this machine's Embree traces 16-wide
+  /// packets natively (AVX-512), else 8. (Embree emulates packets wider than the machine's vectors.)
   int packet_width() const { return native_packet16_ ? 16 : 8; }
   std::span<const Light* const> lights() const override { return lights_; }
   std::span<const Light* const> infinite_lights() const override { return infinite_; }
