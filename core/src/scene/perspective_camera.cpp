@@ -46,6 +46,15 @@ PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_
   screen_of_plane_ = 1.f / (plane_ * tan_half_fov_);
   raster_per_screen_ = Vec2(resolution_.x / (screen_max_.x - screen_min_.x), resolution_.y / (screen_max_.y - screen_min_.y));
   axis_ = glm::normalize(Vec3(to_world_ * Vec4(0.f, 0.f, 1.f, 0.f)));
+  // A pinhole ray's direction before normalisation is linear in the raster position: generate_ray()'s
+  // screen mapping and the camera-to-world rotation folded into one map.
+  glm::mat3 rotation(to_world_);
+  Vec2 per_pixel((screen_max_.x - screen_min_.x) * tan_half_fov_ / resolution_.x,
+                 (screen_max_.y - screen_min_.y) * tan_half_fov_ / resolution_.y);
+  dir_per_x_ = per_pixel.x * rotation[0];
+  dir_per_y_ = -per_pixel.y * rotation[1];
+  dir_at_raster_origin_ = screen_min_.x * tan_half_fov_ * rotation[0] + screen_max_.y * tan_half_fov_ * rotation[1] +
+                          rotation[2];
 }
 
 // pbrt-v4's estimate: rotate camera space so that p lies on +z, offset the central ray's direction
@@ -78,18 +87,21 @@ void PerspectiveCamera::approximate_dp_dxy(const Vec3& p, const Vec3& n, Vec3* d
 }
 
 std::optional<Ray> PerspectiveCamera::generate_ray(const CameraSample& s) const {
+  std::optional<Ray> ray(std::in_place);  // filled where the caller receives it (no copy out)
+  if (lens_radius_ == 0.f) {
+    ray->o = lens_centre_;
+    ray->d = glm::normalize(s.p_film.x * dir_per_x_ + s.p_film.y * dir_per_y_ + dir_at_raster_origin_);
+    ray->tmax = Infinity;
+    return ray;
+  }
   Vec2 screen(screen_min_.x + (s.p_film.x / resolution_.x) * (screen_max_.x - screen_min_.x),
               screen_max_.y - (s.p_film.y / resolution_.y) * (screen_max_.y - screen_min_.y));
   Vec3 dir(screen.x * tan_half_fov_, screen.y * tan_half_fov_, 1.f);
-  Vec3 origin(0.f);
-  if (lens_radius_ > 0.f) {
-    Vec2 lens = lens_radius_ * sample_uniform_disk_concentric(s.p_lens);
-    Vec3 focus = dir * focal_distance_;  // dir.z == 1
-    origin = Vec3(lens, 0.f);
-    dir = focus - origin;
-  }
-  std::optional<Ray> ray(std::in_place);  // filled where the caller receives it (no copy out)
-  ray->o = lens_radius_ > 0.f ? Vec3(to_world_ * Vec4(origin, 1.f)) : lens_centre_;
+  Vec2 lens = lens_radius_ * sample_uniform_disk_concentric(s.p_lens);
+  Vec3 focus = dir * focal_distance_;  // dir.z == 1
+  Vec3 origin(lens, 0.f);
+  dir = focus - origin;
+  ray->o = Vec3(to_world_ * Vec4(origin, 1.f));
   ray->d = glm::normalize(Vec3(to_world_ * Vec4(dir, 0.f)));
   ray->tmax = Infinity;
   return ray;
