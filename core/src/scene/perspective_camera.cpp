@@ -46,15 +46,17 @@ PerspectiveCamera::PerspectiveCamera(const ParamSet& params, const Mat4& camera_
   screen_of_plane_ = 1.f / (plane_ * tan_half_fov_);
   raster_per_screen_ = Vec2(resolution_.x / (screen_max_.x - screen_min_.x), resolution_.y / (screen_max_.y - screen_min_.y));
   axis_ = glm::normalize(Vec3(to_world_ * Vec4(0.f, 0.f, 1.f, 0.f)));
-  // A pinhole ray's direction before normalisation is linear in the raster position: generate_ray()'s
-  // screen mapping and the camera-to-world rotation folded into one map.
+  // The raster position's point on the z = 1 plane is linear in it (the screen window scaled by
+  // tan(fov/2), raster y downwards): camera_dir_per_pixel_ per pixel from the top-left corner
+  // camera_dir_at_raster_origin_. A pinhole's ray direction is that point turned to world space, so
+  // its map is the same one with the camera-to-world rotation folded in.
+  camera_dir_per_pixel_ = Vec2((screen_max_.x - screen_min_.x) * tan_half_fov_ / resolution_.x,
+                               -(screen_max_.y - screen_min_.y) * tan_half_fov_ / resolution_.y);
+  camera_dir_at_raster_origin_ = Vec3(screen_min_.x * tan_half_fov_, screen_max_.y * tan_half_fov_, 1.f);
   glm::mat3 rotation(to_world_);
-  Vec2 per_pixel((screen_max_.x - screen_min_.x) * tan_half_fov_ / resolution_.x,
-                 (screen_max_.y - screen_min_.y) * tan_half_fov_ / resolution_.y);
-  dir_per_x_ = per_pixel.x * rotation[0];
-  dir_per_y_ = -per_pixel.y * rotation[1];
-  dir_at_raster_origin_ = screen_min_.x * tan_half_fov_ * rotation[0] + screen_max_.y * tan_half_fov_ * rotation[1] +
-                          rotation[2];
+  dir_per_x_ = camera_dir_per_pixel_.x * rotation[0];
+  dir_per_y_ = camera_dir_per_pixel_.y * rotation[1];
+  dir_at_raster_origin_ = rotation * camera_dir_at_raster_origin_;
 }
 
 // pbrt-v4's estimate: rotate camera space so that p lies on +z, offset the central ray's direction
@@ -94,11 +96,9 @@ std::optional<Ray> PerspectiveCamera::generate_ray(const CameraSample& s) const 
     ray->tmax = Infinity;
     return ray;
   }
-  Vec2 screen(screen_min_.x + (s.p_film.x / resolution_.x) * (screen_max_.x - screen_min_.x),
-              screen_max_.y - (s.p_film.y / resolution_.y) * (screen_max_.y - screen_min_.y));
-  Vec3 dir(screen.x * tan_half_fov_, screen.y * tan_half_fov_, 1.f);
+  Vec3 dir = camera_dir_at_raster_origin_ + Vec3(s.p_film * camera_dir_per_pixel_, 0.f);  // dir.z == 1
   Vec2 lens = lens_radius_ * sample_uniform_disk_concentric(s.p_lens);
-  Vec3 focus = dir * focal_distance_;  // dir.z == 1
+  Vec3 focus = dir * focal_distance_;
   Vec3 origin(lens, 0.f);
   dir = focus - origin;
   ray->o = Vec3(to_world_ * Vec4(origin, 1.f));

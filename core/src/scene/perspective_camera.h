@@ -55,8 +55,11 @@ class PerspectiveCamera final : public Camera {
   Vec2 raster_per_screen_{0.f};     // raster pixels per screen unit, x and y
   Vec3 axis_{0.f, 0.f, 1.f};        // the viewing direction in world space
   Vec2 margin_{0.f};                // filter radius - 1/2: how far (pixels) importance reaches beyond the film
-  // A pinhole's ray direction (before normalisation) at raster position (x, y):
-  // x dir_per_x_ + y dir_per_y_ + dir_at_raster_origin_, in world space.
+  // Raster position (x, y) to its point on camera space's z = 1 plane:
+  // camera_dir_at_raster_origin_ + (x, y, 0) * camera_dir_per_pixel_; and a pinhole's ray direction
+  // (before normalisation), the same in world space: x dir_per_x_ + y dir_per_y_ + dir_at_raster_origin_.
+  Vec2 camera_dir_per_pixel_{0.f};
+  Vec3 camera_dir_at_raster_origin_{0.f, 0.f, 1.f};
   Vec3 dir_per_x_{0.f}, dir_per_y_{0.f}, dir_at_raster_origin_{0.f, 0.f, 1.f};
 };
 
