@@ -6,7 +6,7 @@
 
 namespace penumbra {
 
-thread_local ThreadRayCount* t_ray_count __attribute__((tls_model("initial-exec"))) = nullptr;
+thread_local constinit ThreadRayCount* t_ray_count __attribute__((tls_model("initial-exec"))) = nullptr;
 
 namespace {
 std::mutex g_mutex;

@@ -13,8 +13,10 @@ struct alignas(64) ThreadRayCount {
   uint64_t rays = 0;
 };
 // Initial-exec TLS: libpenumbra-core is loaded with the program (never dlopen'ed), so the counter
-// is one fs-relative load instead of a __tls_get_addr call per ray.
-extern thread_local ThreadRayCount* t_ray_count __attribute__((tls_model("initial-exec")));
+// is one fs-relative load instead of a __tls_get_addr call per ray. constinit: without it, every
+// caller in another file first loads and tests the address of a possible dynamic initialiser
+// (GCC's TLS wrapper), twice per ray.
+extern thread_local constinit ThreadRayCount* t_ray_count __attribute__((tls_model("initial-exec")));
 
 inline void count_ray() {
   if (!t_ray_count) count_rays_slow_path();
