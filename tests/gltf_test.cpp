@@ -156,6 +156,11 @@ TEST(Gltf, BrokenFilesAreLocatedErrorsNamingTheFile) {
                                 R"("type": "SCALAR"}])",
                                 R"("type": "SCALAR"}, {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"}])");
   expect_error("normals.gltf", normals, "mesh 'cube' primitive 0 has 4 NORMAL values but 8 positions");
+  // Index and vertex counts that are not whole triangles (found by the fuzzer).
+  expect_error("count35.gltf", replace(cube, R"("count": 36,)", R"("count": 35,)"),
+               "mesh 'cube' primitive 0 has 35 indices, not a multiple of 3 for triangles");
+  expect_error("noindices.gltf", replace(cube, R"("indices": 1, )", ""),
+               "mesh 'cube' primitive 0 has 8 vertices (and no indices), not a multiple of 3 for triangles");
   // A count so large that count x stride wraps around 64 bits is still past the end.
   expect_error("count.gltf", replace(cube, R"("count": 8,)", R"("count": 1537228672809129302,)"),
                "reads past the end of its buffer");
