@@ -62,9 +62,9 @@ class CheckedSplats final : public SplatSink {
 // multiples of 16), so a pixel's packet does not depend on passes, threads or split renders.
 constexpr int kBlockWidth = 4, kMaxLanes = 16;
 // Blocks are taken in groups of 2x2 (8x8 pixels for 4x4 blocks): the camera samples and packets of
-// all four blocks, then Li for each of the group's pixels. Block by block, the loop went back and
-// forth between the camera's and the integrator's code 4x as often: grouped, the Cornell box renders
-// 5.5 % faster on two threads (unchanged on one; docs/benchmarks.md, "Blocks in groups of four").
+// all four blocks, then Li for each of the group's pixels. Against block by block, the path tracer
+// renders the Cornell box 5.5 % faster on two threads and as fast on one (why two threads gain was
+// not found; docs/benchmarks.md, "The path integrator without GCC's SLP vectorizer").
 constexpr int kGroupSide = 2, kGroupLanes = kMaxLanes * kGroupSide * kGroupSide;
 
 struct ThreadState {
@@ -83,10 +83,10 @@ struct Lane {
 
 // Starts the pixel samples at `index` of n lanes (a group of blocks): the film position, the lens
 // position and, in a spectral render, the wavelengths (in that order of each lane's sampler
-// dimensions), then each lane's filter sample and camera ray. Each step runs over all lanes before the next: one
-// lane's chain from its sampler's start through the filter to its ray is dependent from end to
-// end, and lanes taken one after the other left the processor little to overlap (lane by lane, the
-// camera samples were about a tenth of the path tracer's time on the Cornell box;
+// dimensions), then each lane's filter sample and camera ray. Each step runs over all lanes before
+// the next: one lane's chain from its sampler's start through the filter to its ray is dependent
+// from end to end, and lanes taken one after the other left the processor little to overlap (lane
+// by lane, the camera samples were about a tenth of the path tracer's time on the Cornell box;
 // docs/benchmarks.md). Each lane's values are the same either way.
 void start_lanes(Lane* lanes, int n, const std::unique_ptr<Sampler>* samplers, uint32_t index, const Film& film,
                  const Camera& camera, bool spectral, const SampledWavelengths* pass_wavelengths) {

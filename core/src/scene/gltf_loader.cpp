@@ -195,8 +195,8 @@ std::vector<GltfPrimitive> load_gltf(const std::string& path, const FileLoc& loc
         } else {
           for (size_t i = 0; i < g.P.size(); ++i) g.indices.push_back(static_cast<int>(i));
         }
-        // Triangles take three vertices each (glTF 2.0, 3.7.2.1); a remainder would be read as part
-        // of a triangle that does not exist (found by the fuzzer).
+        // Triangles take three vertices each; a remainder would be read as part of a triangle that
+        // does not exist (found by the fuzzer).
         if (g.indices.size() % 3 != 0)
           reader.fail(fmt::format("{} has {} {}, not a multiple of 3 for triangles", what, g.indices.size(),
                                   prim.indices >= 0 ? "indices" : "vertices (and no indices)"));
