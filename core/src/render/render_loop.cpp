@@ -173,11 +173,11 @@ void SampleIntegrator::render(RenderContext& ctx) {
   const EmbreeScene* packets = pixel_integrator && pixel_integrator->takes_first_hit()
                                    ? dynamic_cast<const EmbreeScene*>(&scene) : nullptr;
   const int block_w = packets ? kBlockWidth : 1, block_h = packets ? packets->packet_width() / kBlockWidth : 1;
-  const int group_side = packets ? kGroupSide : 1, group_blocks = group_side * group_side;
+  const int group_side = packets ? kGroupSide : 1;
   const int group_w = block_w * group_side, group_h = block_h * group_side;
   tbb::enumerable_thread_specific<ThreadState> threads([&] {
     ThreadState ts{{}, CheckedSplats(ctx, film)};
-    for (int k = 0; k < block_w * block_h * group_blocks; ++k) ts.samplers.push_back(ctx.sampler().clone());
+    for (int k = 0; k < group_w * group_h; ++k) ts.samplers.push_back(ctx.sampler().clone());
     return ts;
   });
 
@@ -229,7 +229,7 @@ void SampleIntegrator::render(RenderContext& ctx) {
             block_start[blocks] = n;
             // Each pixel's samples in index order; the pixels of a group take turns. The packets'
             // hits are declared once per group: intersect_coherent() sets all of them, and an
-            // std::optional declared per sample cost a `rep stos` zero-fill of all eight (GCC 12).
+            // array declared per sample cost a `rep stos` zero-fill of all of it each time (GCC 12).
             std::optional<SurfaceInteraction> hits[kGroupLanes];
             for (int s = 0; s < pass.count; ++s) {
               uint32_t index = pass.first_index + static_cast<uint32_t>(s);
