@@ -23,7 +23,9 @@
 #include <algorithm>
 #include <atomic>
 #include <memory>
+#include <new>
 #include <optional>
+#include <type_traits>
 
 namespace penumbra {
 
@@ -80,6 +82,8 @@ struct Lane {
   std::optional<Ray> ray;
   SampledWavelengths wavelengths;
 };
+// start_lanes() constructs a lane's ray over the last one without destroying it.
+static_assert(std::is_trivially_destructible_v<std::optional<Ray>>);
 
 // Starts the pixel samples at `index` of n lanes (a group of blocks): the film position, the lens
 // position and, in a spectral render, the wavelengths (in that order of each lane's sampler
@@ -114,7 +118,9 @@ void start_lanes(Lane* lanes, int n, const std::unique_ptr<Sampler>* samplers, u
   }
   for (int k = 0; k < n; ++k) {
     Lane& lane = lanes[k];
-    lane.ray = camera.generate_ray(lane.ps.camera);
+    // Constructed in place (the camera writes the ray into the lane): assigned, the ray the camera
+    // had just stored in floats was copied on in 16-byte loads, which stalls store forwarding.
+    ::new (&lane.ray) std::optional<Ray>(camera.generate_ray(lane.ps.camera));
     lane.ps.ray = lane.ray ? &*lane.ray : nullptr;
   }
 }
