@@ -297,6 +297,24 @@ TEST(Samplers, SampleIsAPureFunctionOfPixelIndexDimensionAndSeed) {
   }
 }
 
+// The render loop takes a pixel's indices in order, and samplers may step from the last index to
+// the next (the independent sampler does): in order, out of order and across the index's wrap, each
+// sample equals a fresh sampler's.
+TEST(Samplers, ConsecutiveIndicesEqualFreshStarts) {
+  const uint32_t order[] = {0, 1, 2, 3, 7, 8, 9, 4, 5, 31, 32, 33, 0xfffffffeu, 0xffffffffu, 0u, 1u, 65535u, 65536u};
+  for (const Variant& v : all_variants()) {
+    auto walked = make_sampler(v.sampler, v.randomization, 3);
+    for (uint32_t index : order) {
+      for (uint32_t dim : {0u, 4u}) {
+        auto fresh = make_sampler(v.sampler, v.randomization, 3);
+        walked->start_pixel_sample(Point2i(5, 9), index, dim);
+        fresh->start_pixel_sample(Point2i(5, 9), index, dim);
+        for (int k = 0; k < 3; ++k) EXPECT_EQ(walked->get_1d(), fresh->get_1d()) << describe(v) << " index " << index;
+      }
+    }
+  }
+}
+
 TEST(Samplers, ClonesContinueIdentically) {
   for (const Variant& v : all_variants()) {
     auto s = make_sampler(v.sampler, v.randomization, 2);
