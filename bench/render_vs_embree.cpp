@@ -79,51 +79,68 @@ struct RawResult {
 };
 
 // Incoherent rays: origins uniform in the scene bounds, directions uniform on the sphere; shadow rays
-// join pairs of closest-hit points. Rays are generated before timing.
-RawResult raw_embree(RTCScene scene, const Bounds3& b, size_t n, int threads) {
-  std::vector<RTCRayHit> rays(n);
-  for (size_t i = 0; i < n; ++i) {
-    Pcg32 rng(i, 7);
-    Vec3 o = b.min + (b.max - b.min) * Vec3(rng.next_float(), rng.next_float(), rng.next_float());
-    rays[i] = closest_hit_query(o, sample_uniform_sphere(Vec2(rng.next_float(), rng.next_float())));
-  }
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  std::vector<RTCRayHit> work = rays;
-  double t0 = now();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+// join pairs of closest-hit points. The rays are made once per run and every measurement traces
+// copies of them: made anew in each round, their 400 MB (at 2 M rays) were faulted in and unmapped
+// again around every render, and the renders on two threads that followed rounds on one ran 3-8 %
+// slower than in a run of two-thread rounds only (six alternated pairs of runs, every pair).
+class RawRays {
+ public:
+  RawRays(RTCScene scene, const Bounds3& b, size_t n) : rays_(n), work_(n), shadow_(n), shadow_work_(n) {
+    for (size_t i = 0; i < n; ++i) {
+      Pcg32 rng(i, 7);
+      Vec3 o = b.min + (b.max - b.min) * Vec3(rng.next_float(), rng.next_float(), rng.next_float());
+      rays_[i] = closest_hit_query(o, sample_uniform_sphere(Vec2(rng.next_float(), rng.next_float())));
+    }
+    // Shadow rays between consecutive hit points (the hits of one untimed pass).
+    work_ = rays_;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    for (size_t i = r.begin(); i < r.end(); ++i) rtcIntersect1(scene, &ctx, &work[i]);
-  });
-  double t_closest = now() - t0;
+    for (size_t i = 0; i < n; ++i) rtcIntersect1(scene, &ctx, &work_[i]);
+    for (size_t i = 0; i < n; ++i) {
+      const RTCRayHit& a = work_[i];
+      const RTCRayHit& c = work_[(i * 7919 + 1) % n];
+      auto hit_point = [](const RTCRayHit& h) {
+        float t = std::isfinite(h.ray.tfar) ? h.ray.tfar * 0.999f : 1.f;
+        return Vec3(h.ray.org_x + t * h.ray.dir_x, h.ray.org_y + t * h.ray.dir_y, h.ray.org_z + t * h.ray.dir_z);
+      };
+      Vec3 p = hit_point(a), q = hit_point(c);
+      RTCRay& r = shadow_[i];
+      std::memset(&r, 0, sizeof r);
+      r.org_x = p.x, r.org_y = p.y, r.org_z = p.z;
+      r.dir_x = q.x - p.x, r.dir_y = q.y - p.y, r.dir_z = q.z - p.z;
+      r.tnear = 1e-3f;
+      r.tfar = 0.999f;
+      r.mask = 0xFFFFFFFFu;
+    }
+  }
 
-  // Shadow rays between consecutive hit points.
-  std::vector<RTCRay> shadow(n);
-  for (size_t i = 0; i < n; ++i) {
-    const RTCRayHit& a = work[i];
-    const RTCRayHit& c = work[(i * 7919 + 1) % n];
-    auto hit_point = [](const RTCRayHit& h) {
-      float t = std::isfinite(h.ray.tfar) ? h.ray.tfar * 0.999f : 1.f;
-      return Vec3(h.ray.org_x + t * h.ray.dir_x, h.ray.org_y + t * h.ray.dir_y, h.ray.org_z + t * h.ray.dir_z);
-    };
-    Vec3 p = hit_point(a), q = hit_point(c);
-    RTCRay& r = shadow[i];
-    std::memset(&r, 0, sizeof r);
-    r.org_x = p.x, r.org_y = p.y, r.org_z = p.z;
-    r.dir_x = q.x - p.x, r.dir_y = q.y - p.y, r.dir_z = q.z - p.z;
-    r.tnear = 1e-3f;
-    r.tfar = 0.999f;
-    r.mask = 0xFFFFFFFFu;
+  // Traces copies of the rays (the copies are made before timing, into buffers kept between calls).
+  RawResult measure(RTCScene scene, int threads) {
+    const size_t n = rays_.size();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    std::copy(rays_.begin(), rays_.end(), work_.begin());
+    std::copy(shadow_.begin(), shadow_.end(), shadow_work_.begin());
+    double t0 = now();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      for (size_t i = r.begin(); i < r.end(); ++i) rtcIntersect1(scene, &ctx, &work_[i]);
+    });
+    double t_closest = now() - t0;
+    t0 = now();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      for (size_t i = r.begin(); i < r.end(); ++i) rtcOccluded1(scene, &ctx, &shadow_work_[i]);
+    });
+    double t_shadow = now() - t0;
+    return {n / t_closest * 1e-6, n / t_shadow * 1e-6, 2.0 * n / (t_closest + t_shadow) * 1e-6};
   }
-  t0 = now();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    for (size_t i = r.begin(); i < r.end(); ++i) rtcOccluded1(scene, &ctx, &shadow[i]);
-  });
-  double t_shadow = now() - t0;
-  return {n / t_closest * 1e-6, n / t_shadow * 1e-6, 2.0 * n / (t_closest + t_shadow) * 1e-6};
-}
+
+ private:
+  std::vector<RTCRayHit> rays_, work_;
+  std::vector<RTCRay> shadow_, shadow_work_;
+};
 
 // The scene's camera rays through every pixel centre, traced one at a time (rtcIntersect1), as
 // 8-wide packets of 4x2 pixels (rtcIntersect8, coherent) and as 16-wide packets of 4x4 pixels
@@ -279,6 +296,7 @@ int main(int argc, char** argv) {
       std::vector<double> path_ns, layer_ns[4];          // nanoseconds per sample: path, and the layers
       double path_rays_per_sample = 0, path_mean = 0, minimal_rays_per_sample = 0, minimal_mean = 0;
     };
+    RawRays raw_rays(built.scene->rtc_scene(), built.scene->bounds(), n_rays);
     auto measure = [&](int threads) {
       Rounds r;
       for (int round = 0; round < rounds; ++round) {
@@ -324,7 +342,7 @@ int main(int argc, char** argv) {
           r.robust_ns.push_back(robust.seconds / robust.samples * 1e9);
           r.robust_mrays.push_back(robust.rays / robust.seconds * 1e-6);
         }
-        RawResult raw = raw_embree(built.scene->rtc_scene(), built.scene->bounds(), n_rays, threads);
+        RawResult raw = raw_rays.measure(built.scene->rtc_scene(), threads);
         r.closest.push_back(raw.closest_mrays);
         r.shadow.push_back(raw.shadow_mrays);
         r.mixed.push_back(raw.mixed_mrays);
