@@ -80,9 +80,10 @@ struct RawResult {
 
 // Incoherent rays: origins uniform in the scene bounds, directions uniform on the sphere; shadow rays
 // join pairs of closest-hit points. The rays are made once per run and every measurement traces
-// copies of them: made anew in each round, their 400 MB (at 2 M rays) were faulted in and unmapped
-// again around every render, and the renders on two threads that followed rounds on one ran 3-8 %
-// slower than in a run of two-thread rounds only (six alternated pairs of runs, every pair).
+// copies of them. Made anew in each round, their 400 MB (at 2 M rays) were faulted in and unmapped
+// again around every render; the renders on two threads that followed rounds on one were then 3-9 %
+// slower than in a run of two-thread rounds only in six of six alternated pairs of runs, and after
+// the change in three of six (docs/benchmarks.md).
 class RawRays {
  public:
   RawRays(RTCScene scene, const Bounds3& b, size_t n) : rays_(n), work_(n), shadow_(n), shadow_work_(n) {
