@@ -87,8 +87,14 @@ struct RawResult {
 // the change in three of six (docs/benchmarks.md).
 class RawRays {
  public:
-  RawRays(RTCScene scene, const Bounds3& b, size_t n)
-      : rays_((announce(n), n)), work_(n), shadow_(n), shadow_work_(n) {
+  RawRays(RTCScene scene, const Bounds3& b, size_t n) {
+    // The four buffers are announced before they are allocated: an error naming --rays, not bad_alloc.
+    require_memory(static_cast<uint64_t>(n) * 2 * (sizeof(RTCRayHit) + sizeof(RTCRay)), "--rays: raw Embree's rays",
+                   fmt::format("{} closest-hit and {} shadow rays, each with a copy to trace", n, n));
+    rays_.resize(n);
+    work_.resize(n);
+    shadow_.resize(n);
+    shadow_work_.resize(n);
     for (size_t i = 0; i < n; ++i) {
       Pcg32 rng(i, 7);
       Vec3 o = b.min + (b.max - b.min) * Vec3(rng.next_float(), rng.next_float(), rng.next_float());
@@ -115,12 +121,6 @@ class RawRays {
       r.tfar = 0.999f;
       r.mask = 0xFFFFFFFFu;
     }
-  }
-
-  // The four buffers, announced before they are allocated: an error naming --rays, not bad_alloc.
-  static void announce(size_t n) {
-    require_memory(static_cast<uint64_t>(n) * 2 * (sizeof(RTCRayHit) + sizeof(RTCRay)), "--rays: raw Embree's rays",
-                   fmt::format("{} closest-hit and {} shadow rays, each with a copy to trace", n, n));
   }
 
   // Traces copies of the rays (the copies are made before timing, into buffers kept between calls).
