@@ -378,7 +378,10 @@ int main(int argc, char** argv) {
           j["ratio"] = median(r.ratio);
           j["ratio_min"] = *std::min_element(r.ratio.begin(), r.ratio.end());
           j["ratio_max"] = *std::max_element(r.ratio.begin(), r.ratio.end());
+          j["round_ratios"] = r.ratio;  // each round's, in order, with its two rates
+          j["round_path_mrays_per_second"] = r.path_mrays;
         }
+        j["round_raw_mixed_mrays_per_second"] = r.mixed;
         if (minimal) {
           j["minimal_mrays_per_second"] = median(r.minimal_mrays);
           j["minimal_ratio"] = median(r.minimal_ratio);
