@@ -385,6 +385,7 @@ int main(int argc, char** argv) {
         if (minimal) {
           j["minimal_mrays_per_second"] = median(r.minimal_mrays);
           j["minimal_ratio"] = median(r.minimal_ratio);
+          j["round_minimal_mrays_per_second"] = r.minimal_mrays;
           j["minimal_robust_ratio"] = median(r.robust_ratio);
           j["path_rays_per_sample"] = r.path_rays_per_sample;
           j["minimal_rays_per_sample"] = r.minimal_rays_per_sample;
