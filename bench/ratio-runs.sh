@@ -12,7 +12,7 @@
 #   --scene   default: the program's own (the bundled Cornell box)
 #   --runs    default 12
 #   --target  default 60 (the box's target; cornell-water's is 85)
-#   --keep    write every run's JSON lines (with a "run" field) to FILE
+#   --keep    write every run's JSON lines to FILE (each with "run", its number, and "utc", its start)
 # Example: bench/ratio-runs.sh --runs 24 --keep /tmp/box.jsonl
 set -euo pipefail
 

@@ -15,7 +15,8 @@
 //                     rate and ratio to raw Embree: what the renderer's ratio could be without its overheads;
 //                     and once more with the renderer's robust ray origins (error-bounded offsets) instead
 //                     of a fixed tnear, the one overhead a correct renderer cannot drop
-//   --json            one JSON object per thread count on stdout instead of the table
+//   --json            one JSON object per thread count on stdout instead of the table: the medians, and
+//                     each round's ratio and rates in order (bench/ratio-runs.sh summarises many runs)
 #include "minimal_path_tracer.h"
 #include "number_options.h"
 #include "parser/scene_description.h"
