@@ -88,7 +88,8 @@ struct RawResult {
 // the change in three of six (docs/benchmarks.md).
 class RawRays {
  public:
-  RawRays(RTCScene scene, const Bounds3& b, size_t n) {
+  // The shadow rays join hits in `scene`, so every measurement traces that scene.
+  RawRays(RTCScene scene, const Bounds3& b, size_t n) : scene_(scene) {
     // The four buffers are announced before they are allocated: an error naming --rays, not bad_alloc.
     require_memory(static_cast<uint64_t>(n) * 2 * (sizeof(RTCRayHit) + sizeof(RTCRay)), "--rays: raw Embree's rays",
                    fmt::format("{} closest-hit and {} shadow rays, each with a copy to trace", n, n));
@@ -125,7 +126,7 @@ class RawRays {
   }
 
   // Traces copies of the rays (the copies are made before timing, into buffers kept between calls).
-  RawResult measure(RTCScene scene, int threads) {
+  RawResult measure(int threads) {
     const size_t n = rays_.size();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     std::copy(rays_.begin(), rays_.end(), work_.begin());
@@ -134,20 +135,21 @@ class RawRays {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
-      for (size_t i = r.begin(); i < r.end(); ++i) rtcIntersect1(scene, &ctx, &work_[i]);
+      for (size_t i = r.begin(); i < r.end(); ++i) rtcIntersect1(scene_, &ctx, &work_[i]);
     });
     double t_closest = now() - t0;
     t0 = now();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
-      for (size_t i = r.begin(); i < r.end(); ++i) rtcOccluded1(scene, &ctx, &shadow_work_[i]);
+      for (size_t i = r.begin(); i < r.end(); ++i) rtcOccluded1(scene_, &ctx, &shadow_work_[i]);
     });
     double t_shadow = now() - t0;
     return {n / t_closest * 1e-6, n / t_shadow * 1e-6, 2.0 * n / (t_closest + t_shadow) * 1e-6};
   }
 
  private:
+  RTCScene scene_;
   std::vector<RTCRayHit> rays_, work_;
   std::vector<RTCRay> shadow_, shadow_work_;
 };
@@ -352,7 +354,7 @@ int main(int argc, char** argv) {
           r.robust_ns.push_back(robust.seconds / robust.samples * 1e9);
           r.robust_mrays.push_back(robust.rays / robust.seconds * 1e-6);
         }
-        RawResult raw = raw_rays.measure(built.scene->rtc_scene(), threads);
+        RawResult raw = raw_rays.measure(threads);
         r.closest.push_back(raw.closest_mrays);
         r.shadow.push_back(raw.shadow_mrays);
         r.mixed.push_back(raw.mixed_mrays);
