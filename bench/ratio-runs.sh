@@ -5,7 +5,8 @@
 # "Renderer versus raw Embree"). This runs the default program --runs times, one after the other,
 # keeps every run's JSON lines, and prints per thread count the median of the runs' ratios with a
 # distribution-free interval of at least 95 % for it (bench/pair_stats.py; 6 runs or more), their
-# range, and how many runs were below --target.
+# range, and how many runs were below --target; then the rounds split by the program's probe of core
+# contention (quiet or contended), and the runs' medians over their quiet rounds.
 #   bench/ratio-runs.sh [--build DIR] [--scene FILE] [--runs N] [--target PERCENT] [--keep FILE]
 #                       [-- OPTIONS FOR penumbra-bench-render]
 #   --build   default: build/ of this checkout
@@ -78,4 +79,20 @@ both = {}
 for r in rows:
     both.setdefault(r["run"], []).append(100 * r["ratio"] >= target)
 print(f"runs with every thread count at or above {target:g} %: {sum(all(v) for v in both.values())} of {len(both)}")
+# Rounds split by the core-contention probes (bench/core_contention.h): quiet when every probe of the
+# round was within 10 % of its run's idle value.
+print("rounds by core contention (quiet: every probe within 10 % of the run's idle value): "
+      "ratio, median [95 % interval] (min-max)")
+for threads, rs in sorted(runs_of.items()):
+    quiet, contended = [], []
+    for r in rs:
+        for ratio, c in zip(r["round_ratios"], r["round_core_contention"]):
+            (quiet if c <= 1.1 * r["idle_core_contention"] else contended).append(100 * ratio)
+    for label, v in (("quiet", quiet), ("contended", contended)):
+        print(f"{threads:>7}  {label:<9}  {len(v):>3} rounds  {describe_ratios(v, 1)}  "
+              f"below {target:g} %: {sum(q < target for q in v)}")
+    quiet_runs = [100 * r["ratio_quiet"] for r in rs if "ratio_quiet" in r]
+    if quiet_runs:
+        print(f"{threads:>7}  runs' medians over their quiet rounds ({len(quiet_runs)} of {len(rs)} runs have one): "
+              f"{describe_ratios(quiet_runs, 1)}  below {target:g} %: {sum(q < target for q in quiet_runs)}")
 EOF

@@ -17,6 +17,13 @@
 //                     of a fixed tnear, the one overhead a correct renderer cannot drop
 //   --json            one JSON object per thread count on stdout instead of the table: the medians, and
 //                     each round's ratio and rates in order (bench/ratio-runs.sh summarises many runs)
+// Each round is bracketed by three probes of core contention (bench/core_contention.h: before the
+// render, between it and raw Embree, after both), and ten more come first. The table prints each
+// round's largest index over the smallest of all (the idle value) and the median ratio of the rounds
+// within 10 % of idle; the JSON has `round_core_contention`, `idle_core_contention`, `quiet_rounds` and
+// `ratio_quiet`. Another guest's thread on the same physical core slows the path tracer about twice
+// as much as raw Embree, so the ratio of a contended round says more about the host than the renderer.
+#include "core_contention.h"
 #include "minimal_path_tracer.h"
 #include "number_options.h"
 #include "parser/scene_description.h"
@@ -43,6 +50,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -306,12 +314,28 @@ int main(int argc, char** argv) {
       std::vector<double> minimal_mrays, minimal_ratio;  // with --minimal
       std::vector<double> robust_mrays, robust_ratio, robust_ns;  // the minimal tracer with robust ray origins
       std::vector<double> path_ns, layer_ns[4];          // nanoseconds per sample: path, and the layers
+      std::vector<double> contention;  // per round: the largest core-contention index of its probes
+      double idle_contention = 0;      // the smallest index of all probes: the cores' idle value
+      // The rounds whose probes all stayed within 10 % of the idle value, and their ratios.
+      std::vector<double> quiet_ratio;
+      size_t quiet_rounds() const { return quiet_ratio.size(); }
       double path_rays_per_sample = 0, path_mean = 0, minimal_rays_per_sample = 0, minimal_mean = 0;
     };
     RawRays raw_rays(built.scene->rtc_scene(), built.scene->bounds(), n_rays);
     auto measure = [&](int threads) {
       Rounds r;
+      // The idle value is the smallest index seen: ten probes first, 20 ms apart, then the rounds'.
+      // Contention comes and goes within a second even in a contended phase, so one of them
+      // usually finds the core to itself.
+      r.idle_contention = Infinity;
+      for (int k = 0; k < 10; ++k) {
+        r.idle_contention = std::min(r.idle_contention, bench::probe_cores(threads));
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      std::vector<double> round_low;
       for (int round = 0; round < rounds; ++round) {
+        // The probes bracket the render and the raw measurement (bench/core_contention.h).
+        double contention = bench::probe_cores(threads), low = contention;
         if (!raw_only) {
           RenderSettings settings;
           settings.scene_file = scene_file;
@@ -354,7 +378,12 @@ int main(int argc, char** argv) {
           r.robust_ns.push_back(robust.seconds / robust.samples * 1e9);
           r.robust_mrays.push_back(robust.rays / robust.seconds * 1e-6);
         }
+        double mid = bench::probe_cores(threads);
+        contention = std::max(contention, mid), low = std::min(low, mid);
         RawResult raw = raw_rays.measure(threads);
+        double after = bench::probe_cores(threads);
+        r.contention.push_back(std::max(contention, after));
+        round_low.push_back(std::min(low, after));
         r.closest.push_back(raw.closest_mrays);
         r.shadow.push_back(raw.shadow_mrays);
         r.mixed.push_back(raw.mixed_mrays);
@@ -364,6 +393,10 @@ int main(int argc, char** argv) {
           r.robust_ratio.push_back(r.robust_mrays.back() / raw.mixed_mrays);
         }
       }
+      for (double low : round_low) r.idle_contention = std::min(r.idle_contention, low);
+      if (!raw_only)
+        for (int round = 0; round < rounds; ++round)
+          if (r.contention[round] <= 1.1 * r.idle_contention) r.quiet_ratio.push_back(r.ratio[round]);
       return r;
     };
     if (raw_only || json) {
@@ -383,7 +416,11 @@ int main(int argc, char** argv) {
           j["ratio_max"] = *std::max_element(r.ratio.begin(), r.ratio.end());
           j["round_ratios"] = r.ratio;  // each round's, in order, with its two rates
           j["round_path_mrays_per_second"] = r.path_mrays;
+          j["quiet_rounds"] = r.quiet_rounds();
+          if (r.quiet_rounds()) j["ratio_quiet"] = median(r.quiet_ratio);
         }
+        j["round_core_contention"] = r.contention;
+        j["idle_core_contention"] = r.idle_contention;
         j["round_raw_mixed_mrays_per_second"] = r.mixed;
         if (minimal) {
           j["minimal_mrays_per_second"] = median(r.minimal_mrays);
@@ -419,6 +456,13 @@ int main(int argc, char** argv) {
                  100.0 * median(r.ratio),
                  fmt::format("[{:.1f}, {:.1f}]", 100.0 * *std::min_element(r.ratio.begin(), r.ratio.end()),
                              100.0 * *std::max_element(r.ratio.begin(), r.ratio.end())));
+      std::string per_round;
+      for (double c : r.contention) per_round += fmt::format(" {:.2f}", c / r.idle_contention);
+      fmt::print("{:>7} core contention per round, over idle ({:.2f}):{}; ", threads, r.idle_contention, per_round);
+      if (r.quiet_rounds())
+        fmt::print("ratio over the {} rounds within 10 % of idle {:.1f}%\n", r.quiet_rounds(), 100.0 * median(r.quiet_ratio));
+      else
+        fmt::print("no round within 10 % of idle\n");
       if (minimal) {
         fmt::print("{:>7} minimal path tracer on raw Embree: {:.2f} Mrays/s, ratio {:.1f}% [{:.1f}, {:.1f}]; rays per "
                    "sample {:.3f} (path {:.3f}); image mean {:.5f} (path {:.5f})\n",
