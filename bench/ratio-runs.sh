@@ -80,19 +80,24 @@ for r in rows:
     both.setdefault(r["run"], []).append(100 * r["ratio"] >= target)
 print(f"runs with every thread count at or above {target:g} %: {sum(all(v) for v in both.values())} of {len(both)}")
 # Rounds split by the core-contention probes (bench/core_contention.h): quiet when every probe of the
-# round was within 10 % of its run's idle value.
-print("rounds by core contention (quiet: every probe within 10 % of the run's idle value): "
+# round was within 10 % of the idle value, the smallest index of all runs at that thread count (a run
+# inside a contended phase finds no idle probe of its own).
+print("rounds by core contention (quiet: every probe within 10 % of the idle value, the smallest of all runs): "
       "ratio, median [95 % interval] (min-max)")
 for threads, rs in sorted(runs_of.items()):
-    quiet, contended = [], []
+    idle = min(r["idle_core_contention"] for r in rs)
+    quiet, contended, quiet_runs = [], [], []
     for r in rs:
+        mine = []
         for ratio, c in zip(r["round_ratios"], r["round_core_contention"]):
-            (quiet if c <= 1.1 * r["idle_core_contention"] else contended).append(100 * ratio)
+            (mine if c <= 1.1 * idle else contended).append(100 * ratio)
+        quiet += mine
+        if mine:
+            quiet_runs.append(sorted(mine)[len(mine) // 2] if len(mine) % 2 else
+                              0.5 * (sorted(mine)[len(mine) // 2 - 1] + sorted(mine)[len(mine) // 2]))
     for label, v in (("quiet", quiet), ("contended", contended)):
         print(f"{threads:>7}  {label:<9}  {len(v):>3} rounds  {describe_ratios(v, 1)}  "
               f"below {target:g} %: {sum(q < target for q in v)}")
-    quiet_runs = [100 * r["ratio_quiet"] for r in rs if "ratio_quiet" in r]
-    if quiet_runs:
-        print(f"{threads:>7}  runs' medians over their quiet rounds ({len(quiet_runs)} of {len(rs)} runs have one): "
-              f"{describe_ratios(quiet_runs, 1)}  below {target:g} %: {sum(q < target for q in quiet_runs)}")
+    print(f"{threads:>7}  idle value {idle:.2f}; runs' medians over their quiet rounds ({len(quiet_runs)} of {len(rs)} "
+          f"runs have one): {describe_ratios(quiet_runs, 1)}  below {target:g} %: {sum(q < target for q in quiet_runs)}")
 EOF

@@ -2,7 +2,7 @@
 // Cornell box and (2) Embree's raw throughput for incoherent closest-hit and shadow rays with no
 // shading, and prints their ratio.
 // Usage: penumbra-bench-render [--scene FILE] [--threads N] [--spp N] [--res N] [--rays N] [--rounds N]
-//                              [--raw-only] [--camera-packets] [--minimal] [--json]
+//                              [--raw-only] [--camera-packets] [--minimal] [--json] [--idle-contention X]
 //   --rounds N        the render and the raw measurement alternate N times per thread count (default 5);
 //                     each round gives a ratio, and the median ratio and the range are reported, so a
 //                     drift of the machine between the two measurements moves one round, not the figure
@@ -19,9 +19,12 @@
 //                     each round's ratio and rates in order (bench/ratio-runs.sh summarises many runs)
 // Each round is bracketed by three probes of core contention (bench/core_contention.h: before the
 // render, between it and raw Embree, after both), and ten more come first. The table prints each
-// round's largest index over the smallest of all (the idle value) and the median ratio of the rounds
-// within 10 % of idle; the JSON has `round_core_contention`, `idle_core_contention`, `quiet_rounds` and
-// `ratio_quiet`. Another guest's thread on the same physical core slows the path tracer about twice
+// round's largest index over the idle value and the median ratio of the rounds within 10 % of it; the
+// JSON has `round_core_contention`, `idle_core_contention` (this run's smallest index), `quiet_rounds`
+// and `ratio_quiet`. The idle value is this run's smallest index unless --idle-contention gives one:
+//   --idle-contention X  the core's idle index on this machine (the smallest `idle_core_contention` of
+//                     earlier runs; bench/ratio-runs.sh prints it). A run that falls wholly inside a
+//                     contended phase finds no idle probe of its own, and says so when X is given. Another guest's thread on the same physical core slows the path tracer about twice
 // as much as raw Embree, so the ratio of a contended round says more about the host than the renderer.
 #include "core_contention.h"
 #include "minimal_path_tracer.h"
@@ -257,6 +260,7 @@ int main(int argc, char** argv) {
   int spp = 32, res = 256, rounds = 5, threads_option = 0;
   size_t n_rays = 2'000'000;
   bool raw_only = false, json = false, camera_packets = false, minimal = false;
+  double idle_option = 0;
   std::string scene_file = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-box/scene.pbrt";
   CLI::App app{"The path tracer's ray rate against raw Embree on the same geometry"};
   app.add_option("--scene", scene_file, "pbrt-v4 scene file (default: the bundled Cornell box)")
@@ -274,6 +278,9 @@ int main(int argc, char** argv) {
   app.add_flag("--camera-packets", camera_packets, "only the camera rays, one at a time and as 8- and 16-wide packets");
   app.add_flag("--minimal", minimal, "also the minimal path tracer on raw Embree, in every round");
   app.add_flag("--json", json, "one JSON object per thread count instead of the table");
+  app.add_option("--idle-contention", idle_option,
+                 "the core-contention index of an idle core on this machine (default: this run's smallest)")
+      ->check(cli::positive_number());
   if (std::optional<int> exit_code = cli::parse_tool_options(app, argc, argv, "penumbra-bench-render:"))
     return *exit_code;
   std::vector<int> thread_counts = threads_option > 0 ? std::vector<int>{threads_option} : std::vector<int>{1, 2};
@@ -315,7 +322,8 @@ int main(int argc, char** argv) {
       std::vector<double> robust_mrays, robust_ratio, robust_ns;  // the minimal tracer with robust ray origins
       std::vector<double> path_ns, layer_ns[4];          // nanoseconds per sample: path, and the layers
       std::vector<double> contention;  // per round: the largest core-contention index of its probes
-      double idle_contention = 0;      // the smallest index of all probes: the cores' idle value
+      double idle_contention = 0;      // the smallest index of all probes
+      double idle_reference = 0;       // what rounds are compared with: --idle-contention, or the above
       // The rounds whose probes all stayed within 10 % of the idle value, and their ratios.
       std::vector<double> quiet_ratio;
       size_t quiet_rounds() const { return quiet_ratio.size(); }
@@ -394,9 +402,10 @@ int main(int argc, char** argv) {
         }
       }
       for (double low : round_low) r.idle_contention = std::min(r.idle_contention, low);
+      r.idle_reference = idle_option > 0 ? idle_option : r.idle_contention;
       if (!raw_only)
         for (int round = 0; round < rounds; ++round)
-          if (r.contention[round] <= 1.1 * r.idle_contention) r.quiet_ratio.push_back(r.ratio[round]);
+          if (r.contention[round] <= 1.1 * r.idle_reference) r.quiet_ratio.push_back(r.ratio[round]);
       return r;
     };
     if (raw_only || json) {
@@ -421,6 +430,7 @@ int main(int argc, char** argv) {
         }
         j["round_core_contention"] = r.contention;
         j["idle_core_contention"] = r.idle_contention;
+        j["idle_reference"] = r.idle_reference;
         j["round_raw_mixed_mrays_per_second"] = r.mixed;
         if (minimal) {
           j["minimal_mrays_per_second"] = median(r.minimal_mrays);
@@ -457,8 +467,9 @@ int main(int argc, char** argv) {
                  fmt::format("[{:.1f}, {:.1f}]", 100.0 * *std::min_element(r.ratio.begin(), r.ratio.end()),
                              100.0 * *std::max_element(r.ratio.begin(), r.ratio.end())));
       std::string per_round;
-      for (double c : r.contention) per_round += fmt::format(" {:.2f}", c / r.idle_contention);
-      fmt::print("{:>7} core contention per round, over idle ({:.2f}):{}; ", threads, r.idle_contention, per_round);
+      for (double c : r.contention) per_round += fmt::format(" {:.2f}", c / r.idle_reference);
+      fmt::print("{:>7} core contention per round, over idle ({:.2f}{}):{}; ", threads, r.idle_reference,
+                 idle_option > 0 ? fmt::format(", this run's smallest {:.2f}", r.idle_contention) : "", per_round);
       if (r.quiet_rounds())
         fmt::print("ratio over the {} rounds within 10 % of idle {:.1f}%\n", r.quiet_rounds(), 100.0 * median(r.quiet_ratio));
       else
