@@ -6,8 +6,8 @@
 // operations, which waits on latency and uses little of the core, runs at the clock's pace. On this
 // project's machine such phases come and go over seconds, and in them the path tracer slowed by
 // about a third and raw Embree's traversal by about a sixth (docs/benchmarks.md, "What slows the
-// path tracer more than Embree"). The probe times both kinds of loop back to back; their quotient
-// does not change with the clock and grows with the contention.
+// path tracer more than Embree"). The probe times both kinds of loop in alternating parts; their
+// quotient does not change with the clock and grows with the contention.
 #pragma once
 
 namespace penumbra::bench {

@@ -55,7 +55,7 @@ done
 [ -n "$keep" ] && cp "$lines" "$keep"
 
 "$(bench_python)" - "$lines" "$target" "$root/bench" <<'EOF'
-import json, sys
+import json, statistics, sys
 sys.path.insert(0, sys.argv[3])
 from pair_stats import describe_ratios
 target = float(sys.argv[2])
@@ -93,8 +93,7 @@ for threads, rs in sorted(runs_of.items()):
             (mine if c <= 1.1 * idle else contended).append(100 * ratio)
         quiet += mine
         if mine:
-            quiet_runs.append(sorted(mine)[len(mine) // 2] if len(mine) % 2 else
-                              0.5 * (sorted(mine)[len(mine) // 2 - 1] + sorted(mine)[len(mine) // 2]))
+            quiet_runs.append(statistics.median(mine))
     for label, v in (("quiet", quiet), ("contended", contended)):
         print(f"{threads:>7}  {label:<9}  {len(v):>3} rounds  {describe_ratios(v, 1)}  "
               f"below {target:g} %: {sum(q < target for q in v)}")

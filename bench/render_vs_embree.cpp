@@ -17,15 +17,17 @@
 //                     of a fixed tnear, the one overhead a correct renderer cannot drop
 //   --json            one JSON object per thread count on stdout instead of the table: the medians, and
 //                     each round's ratio and rates in order (bench/ratio-runs.sh summarises many runs)
+//   --idle-contention X  the core-contention index of an idle core on this machine (the smallest
+//                     `idle_core_contention` of earlier runs; bench/ratio-runs.sh prints it)
 // Each round is bracketed by three probes of core contention (bench/core_contention.h: before the
 // render, between it and raw Embree, after both), and ten more come first. The table prints each
-// round's largest index over the idle value and the median ratio of the rounds within 10 % of it; the
-// JSON has `round_core_contention`, `idle_core_contention` (this run's smallest index), `quiet_rounds`
-// and `ratio_quiet`. The idle value is this run's smallest index unless --idle-contention gives one:
-//   --idle-contention X  the core's idle index on this machine (the smallest `idle_core_contention` of
-//                     earlier runs; bench/ratio-runs.sh prints it). A run that falls wholly inside a
-//                     contended phase finds no idle probe of its own, and says so when X is given. Another guest's thread on the same physical core slows the path tracer about twice
-// as much as raw Embree, so the ratio of a contended round says more about the host than the renderer.
+// round's largest index over the idle value and the median ratio of the rounds within 10 % of it
+// (quiet rounds). The idle value is --idle-contention, or else this run's smallest index, which a run
+// that falls wholly inside a contended phase does not find. The JSON has `round_core_contention`,
+// `idle_core_contention` (this run's smallest), `idle_reference` (the idle value used), `quiet_rounds`
+// and `ratio_quiet`. Another guest's thread on the same physical core slows the path tracer about
+// twice as much as raw Embree, so the ratio of a contended round says more about the host than the
+// renderer.
 #include "core_contention.h"
 #include "minimal_path_tracer.h"
 #include "number_options.h"
