@@ -55,7 +55,7 @@ CoreContention probe_core(long steps) {
   CoreContention c;
   c.call_ns = median(call);
   c.chain_ns = median(chain);
-  c.quotient = median(quotient);
+  c.index = median(quotient);
   return c;
 }
 
@@ -63,7 +63,7 @@ double probe_cores(int threads, long steps) {
   // The thread pool's workers spin for a while after parallel work before they sleep; a probe run
   // then shares its processor with one of them.
   std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  if (threads <= 1) return probe_core(steps).index();
+  if (threads <= 1) return probe_core(steps).index;
   // One probe per processor the program may use: new threads start on their parent's processor
   // and two probes sharing one for a while measured each other.
   cpu_set_t allowed;
@@ -82,7 +82,7 @@ double probe_cores(int threads, long steps) {
         CPU_SET(cpus[k], &one);
         pthread_setaffinity_np(pthread_self(), sizeof one, &one);
       }
-      index[k] = probe_core(steps).index();
+      index[k] = probe_core(steps).index;
     });
   for (std::thread& w : workers) w.join();
   return *std::max_element(index.begin(), index.end());

@@ -15,9 +15,9 @@ namespace penumbra::bench {
 struct CoreContention {
   double call_ns = 0;   // per call of an out-of-line function, the calls independent (throughput)
   double chain_ns = 0;  // per step of a dependent multiply-add chain (latency: the clock only)
-  double quotient = 0;  // of the two, part by part (the loops alternate in parts)
-  /// call_ns / chain_ns: about constant on an idle core of a given processor, larger under contention.
-  double index() const { return quotient; }
+  /// call / chain, part by part (the loops alternate in parts): about constant on an idle core of a
+  /// given processor, larger under contention.
+  double index = 0;
 };
 
 /// Times `steps` of each loop on the calling thread (4 million: about 10 ms in all here), in eight

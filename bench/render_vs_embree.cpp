@@ -326,9 +326,7 @@ int main(int argc, char** argv) {
       std::vector<double> contention;  // per round: the largest core-contention index of its probes
       double idle_contention = 0;      // the smallest index of all probes
       double idle_reference = 0;       // what rounds are compared with: --idle-contention, or the above
-      // The rounds whose probes all stayed within 10 % of the idle value, and their ratios.
-      std::vector<double> quiet_ratio;
-      size_t quiet_rounds() const { return quiet_ratio.size(); }
+      std::vector<double> quiet_ratio;  // of the rounds whose probes all stayed within 10 % of idle
       double path_rays_per_sample = 0, path_mean = 0, minimal_rays_per_sample = 0, minimal_mean = 0;
     };
     RawRays raw_rays(built.scene->rtc_scene(), built.scene->bounds(), n_rays);
@@ -342,10 +340,10 @@ int main(int argc, char** argv) {
         r.idle_contention = std::min(r.idle_contention, bench::probe_cores(threads));
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
-      std::vector<double> round_low;
       for (int round = 0; round < rounds; ++round) {
         // The probes bracket the render and the raw measurement (bench/core_contention.h).
-        double contention = bench::probe_cores(threads), low = contention;
+        double probes[3];
+        probes[0] = bench::probe_cores(threads);
         if (!raw_only) {
           RenderSettings settings;
           settings.scene_file = scene_file;
@@ -388,12 +386,11 @@ int main(int argc, char** argv) {
           r.robust_ns.push_back(robust.seconds / robust.samples * 1e9);
           r.robust_mrays.push_back(robust.rays / robust.seconds * 1e-6);
         }
-        double mid = bench::probe_cores(threads);
-        contention = std::max(contention, mid), low = std::min(low, mid);
+        probes[1] = bench::probe_cores(threads);
         RawResult raw = raw_rays.measure(threads);
-        double after = bench::probe_cores(threads);
-        r.contention.push_back(std::max(contention, after));
-        round_low.push_back(std::min(low, after));
+        probes[2] = bench::probe_cores(threads);
+        r.contention.push_back(*std::max_element(probes, probes + 3));
+        r.idle_contention = std::min(r.idle_contention, *std::min_element(probes, probes + 3));
         r.closest.push_back(raw.closest_mrays);
         r.shadow.push_back(raw.shadow_mrays);
         r.mixed.push_back(raw.mixed_mrays);
@@ -403,7 +400,6 @@ int main(int argc, char** argv) {
           r.robust_ratio.push_back(r.robust_mrays.back() / raw.mixed_mrays);
         }
       }
-      for (double low : round_low) r.idle_contention = std::min(r.idle_contention, low);
       r.idle_reference = idle_option > 0 ? idle_option : r.idle_contention;
       if (!raw_only)
         for (int round = 0; round < rounds; ++round)
@@ -427,8 +423,8 @@ int main(int argc, char** argv) {
           j["ratio_max"] = *std::max_element(r.ratio.begin(), r.ratio.end());
           j["round_ratios"] = r.ratio;  // each round's, in order, with its two rates
           j["round_path_mrays_per_second"] = r.path_mrays;
-          j["quiet_rounds"] = r.quiet_rounds();
-          if (r.quiet_rounds()) j["ratio_quiet"] = median(r.quiet_ratio);
+          j["quiet_rounds"] = r.quiet_ratio.size();
+          if (!r.quiet_ratio.empty()) j["ratio_quiet"] = median(r.quiet_ratio);
         }
         j["round_core_contention"] = r.contention;
         j["idle_core_contention"] = r.idle_contention;
@@ -472,8 +468,9 @@ int main(int argc, char** argv) {
       for (double c : r.contention) per_round += fmt::format(" {:.2f}", c / r.idle_reference);
       fmt::print("{:>7} core contention per round, over idle ({:.2f}{}):{}; ", threads, r.idle_reference,
                  idle_option > 0 ? fmt::format(", this run's smallest {:.2f}", r.idle_contention) : "", per_round);
-      if (r.quiet_rounds())
-        fmt::print("ratio over the {} rounds within 10 % of idle {:.1f}%\n", r.quiet_rounds(), 100.0 * median(r.quiet_ratio));
+      if (!r.quiet_ratio.empty())
+        fmt::print("ratio over the {} rounds within 10 % of idle {:.1f}%\n", r.quiet_ratio.size(),
+                   100.0 * median(r.quiet_ratio));
       else
         fmt::print("no round within 10 % of idle\n");
       if (minimal) {
