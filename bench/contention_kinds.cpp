@@ -21,9 +21,9 @@
 //
 // Usage: penumbra-bench-contention [--seconds N]   (default 120; pin it with taskset -c CPU)
 #include "number_options.h"
+#include "timing.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <optional>
@@ -31,15 +31,8 @@
 
 namespace {
 
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using penumbra::bench::median;
+using penumbra::bench::now;
 
 [[gnu::noinline]] uint32_t call_step(uint32_t x) {
   asm volatile("" : "+r"(x));

@@ -1,4 +1,5 @@
 #include "core_contention.h"
+#include "timing.h"
 
 #include <pthread.h>
 #include <sched.h>
@@ -12,10 +13,6 @@
 namespace penumbra::bench {
 
 namespace {
-
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 // One multiply-add behind a call; the empty asm keeps the compiler from seeing through it.
 [[gnu::noinline]] uint32_t probe_step(uint32_t x) {
@@ -48,14 +45,10 @@ CoreContention probe_core(long steps) {
     quotient[k] = call[k] / chain[k];
   }
   asm volatile("" : : "r"(h));
-  auto median = [](double* v) {
-    std::sort(v, v + kParts);
-    return 0.5 * (v[kParts / 2 - 1] + v[kParts / 2]);
-  };
   CoreContention c;
-  c.call_ns = median(call);
-  c.chain_ns = median(chain);
-  c.index = median(quotient);
+  c.call_ns = median({call, call + kParts});
+  c.chain_ns = median({chain, chain + kParts});
+  c.index = median({quotient, quotient + kParts});
   return c;
 }
 

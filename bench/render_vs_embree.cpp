@@ -35,6 +35,7 @@
 #include "registry/registry.h"
 #include "render/render_session.h"
 #include "scene/scene_builder.h"
+#include "timing.h"
 
 #include <penumbra/memory.h>
 #include <penumbra/rng.h>
@@ -66,16 +67,8 @@ constexpr unsigned kLayerSets[4] = {kMinimalOnly, kHits, kHits | kLights, kHits 
 
 namespace {
 
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-// Median of a non-empty list (the mean of the two middle values for an even count).
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using bench::median;
+using bench::now;
 
 // A closest-hit query from o along d over (0, infinity), as Embree takes it.
 RTCRayHit closest_hit_query(const Vec3& o, const Vec3& d) {
