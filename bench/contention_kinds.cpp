@@ -1,9 +1,9 @@
 // Which kinds of code slow down when another hardware thread shares this processor core.
 //
 // bench/core_contention.h detects the contention; this program says what it costs each kind of
-// work, so that a change to the renderer can be judged by the kind of code it removes. Five loops
-// alternate, each about 2 ms a part, and every second the program prints each loop's median time per
-// step over that second's parts:
+// work, so that a change to the renderer can be judged by the kind of code it removes. Seven loops
+// alternate in parts of 0.2-1 ms each, and every second the program prints each loop's median time
+// per step over that second's parts:
 //   call   independent calls of an out-of-line function (call, return, a multiply-add);
 //   alu    16 independent one-cycle integer operations in 8 chains: as many per cycle as the core's
 //          arithmetic units take (the kind of code that issues 3-4 instructions per cycle);
@@ -54,8 +54,8 @@ constexpr int kJumps = 64;
   asm volatile(".rept 64\n jmp 1f\n nop\n 1: add $1, %0\n .endr\n" : "+r"(a));
 }
 
-// Straight-line code of `kOps` 4-byte operations (add or xor of an 8-bit immediate to a 64-bit
-// register), in four independent chains.
+// Straight-line code of 4 x `repeats` 4-byte operations (add or xor of an 8-bit immediate to a
+// 64-bit register), in four independent chains.
 #define PENUMBRA_STRAIGHT_CODE(name, repeats)                                                        \
   [[gnu::noinline]] void name() {                                                                    \
     uint64_t a = 1, b = 2, c = 3, d = 4;                                                             \
