@@ -77,6 +77,15 @@ uint64_t chain_steps(long n, uint64_t x) {
 constexpr int kLoops = 7;
 const char* const kNames[kLoops] = {"call", "alu", "jump", "code2", "code12", "code48", "chain"};
 
+// Nanoseconds per operation of `fn`, which does `ops` operations a call, over about `total` of them.
+template <class Fn>
+double ns_per_op(Fn fn, long ops, long total) {
+  const long calls = total / ops;
+  double t0 = now();
+  for (long i = 0; i < calls; ++i) fn();
+  return (now() - t0) / (static_cast<double>(calls) * static_cast<double>(ops)) * 1e9;
+}
+
 // One part of each loop; nanoseconds per step.
 void run_parts(double* ns) {
   const long n = 300'000;
@@ -86,25 +95,17 @@ void run_parts(double* ns) {
   double t1 = now();
   alu_steps(n);
   double t2 = now();
-  for (long i = 0; i < n / 16; ++i) jumps();
-  double t3 = now();
-  // About as many operations of each code size: 12,288 per call of the largest.
-  for (long i = 0; i < n / 16; ++i) code_2kb();
-  double t4 = now();
-  for (long i = 0; i < n / 96; ++i) code_12kb();
-  double t5 = now();
-  for (long i = 0; i < n / 384; ++i) code_48kb();
-  double t6 = now();
-  uint64_t x = chain_steps(n, s);
-  double t7 = now();
-  asm volatile("" : : "r"(x));
   ns[0] = (t1 - t0) / n * 1e9;
   ns[1] = (t2 - t1) / n * 1e9;
-  ns[2] = (t3 - t2) / (n / 16 * double(kJumps)) * 1e9;
-  ns[3] = (t4 - t3) / (n / 16 * 512.0) * 1e9;
-  ns[4] = (t5 - t4) / (n / 96 * 3072.0) * 1e9;
-  ns[5] = (t6 - t5) / (n / 384 * 12288.0) * 1e9;
-  ns[6] = (t7 - t6) / n * 1e9;
+  ns[2] = ns_per_op(jumps, kJumps, 4 * n);
+  // As many operations of each code size (4 per repeat of its `.rept`).
+  ns[3] = ns_per_op(code_2kb, 4 * 128, 32 * n);
+  ns[4] = ns_per_op(code_12kb, 4 * 768, 32 * n);
+  ns[5] = ns_per_op(code_48kb, 4 * 3072, 32 * n);
+  double t3 = now();
+  uint64_t x = chain_steps(n, s);
+  ns[6] = (now() - t3) / n * 1e9;
+  asm volatile("" : : "r"(x));
 }
 
 }  // namespace

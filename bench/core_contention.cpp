@@ -28,7 +28,7 @@ CoreContention probe_core(long steps) {
   // loop, whereas a sibling thread's contention lasts through all of them.
   constexpr int kParts = 8;
   const long part = std::max(1L, steps / kParts);
-  double call[kParts], chain[kParts], quotient[kParts];
+  std::vector<double> call(kParts), chain(kParts), quotient(kParts);
   uint32_t sum = 0;
   uint64_t h = 1;
   for (int k = 0; k < kParts; ++k) {
@@ -46,9 +46,9 @@ CoreContention probe_core(long steps) {
   }
   asm volatile("" : : "r"(h));
   CoreContention c;
-  c.call_ns = median({call, call + kParts});
-  c.chain_ns = median({chain, chain + kParts});
-  c.index = median({quotient, quotient + kParts});
+  c.call_ns = median(call);
+  c.chain_ns = median(chain);
+  c.index = median(quotient);
   return c;
 }
 
